@@ -1,0 +1,363 @@
+"""Kernels: write a formula once, evaluate it on every backend.
+
+A kernel is a plain Python function of scalar components that returns a tuple of
+scalar components. It may call the primitives of :mod:`.primitives` and other
+functions registered with :func:`helper`. :func:`kernel` declares the trailing
+shape of each array input and output, and turns the function into a
+:class:`Kernel` that takes and returns arrays batched over leading axes
+(broadcasting like NumPy):
+
+>>> from rigidkit._engine import kernel
+>>> @kernel(inputs=[(2,)], outputs=[()])
+... def norm2(x, y):
+...     return (sqrt(x * x + y * y),)
+>>> float(norm2([3.0, 4.0]))
+5.0
+
+Dispatch, for ``a = kernel(arrays...)``:
+
+* NumPy, one element: the function itself over Python floats (lowest latency);
+* NumPy, more than ``NUMBA_MIN`` elements (or a loop already compiled in this
+  process): the fused numba loop, split over cores for large batches;
+* otherwise, any array namespace: element-wise evaluation with ``xp`` functions.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import types
+
+import numpy as np
+
+from . import numba_backend
+from .namespace import device_of, float_dtype_of, is_numpy, namespace_of
+from .primitives import PRIMITIVES, math_bindings, sympy_bindings, xp_bindings
+
+#: Below this many elements a NumPy call never waits for a JIT compile.
+NUMBA_MIN = int(os.environ.get("RIGIDKIT_NUMBA_MIN", "1000"))
+
+_HELPERS: dict[str, "Helper"] = {}
+_F64 = np.dtype(np.float64)
+_F32 = np.dtype(np.float32)
+
+
+def _free_names(fn) -> set[str]:
+    names = set(fn.__code__.co_names)
+    for const in fn.__code__.co_consts:
+        if isinstance(const, types.CodeType):
+            names |= set(const.co_names)
+    return names
+
+
+def _rebind(fn, bindings: dict):
+    """A copy of ``fn`` whose globals are ``bindings`` (primitives + helpers)."""
+    return types.FunctionType(fn.__code__, bindings, fn.__name__, fn.__defaults__)
+
+
+class _Rebindable:
+    """Shared machinery of helpers and kernels: dependency walk and rebinding."""
+
+    def __init__(self, fn):
+        self.fn = fn
+        self.name = fn.__name__
+        self.__doc__ = fn.__doc__
+        self.__wrapped__ = fn
+        for name in _free_names(fn):
+            if name not in PRIMITIVES and name not in _HELPERS and not _is_builtin(name):
+                raise NameError(
+                    f"kernel {self.name} uses {name!r}, which is neither a primitive "
+                    f"nor a registered helper"
+                )
+
+    def dependencies(self) -> list["Helper"]:
+        """Helpers called by this function, transitively, callees first."""
+        order: list[Helper] = []
+        seen: set[str] = set()
+
+        def visit(fn):
+            for name in sorted(_free_names(fn)):
+                if name in _HELPERS and name not in seen:
+                    seen.add(name)
+                    visit(_HELPERS[name].fn)
+                    order.append(_HELPERS[name])
+
+        visit(self.fn)
+        return order
+
+    def bound(self, primitives: dict):
+        """This function with ``primitives`` and rebound helpers as its globals."""
+        env = dict(primitives)
+        for dep in self.dependencies():
+            env[dep.name] = _rebind(dep.fn, env)
+        return _rebind(self.fn, env)
+
+
+def _is_builtin(name: str) -> bool:
+    import builtins
+
+    return hasattr(builtins, name)
+
+
+class Helper(_Rebindable):
+    """A scalar function shared by kernels (a coefficient with its series, say)."""
+
+    def __init__(self, fn):
+        super().__init__(fn)
+        self._py = None
+
+    def __call__(self, *args):
+        if self._py is None:
+            self._py = self.bound(math_bindings())
+        return self._py(*args)
+
+
+def helper(fn) -> Helper:
+    """Register ``fn`` as a helper that kernels may call by name."""
+    h = Helper(fn)
+    _HELPERS[h.name] = h
+    return h
+
+
+class Kernel(_Rebindable):
+    """A scalar formula bound to numba loops, array namespaces, floats and SymPy."""
+
+    def __init__(self, fn, inputs, outputs, params=()):
+        super().__init__(fn)
+        self.inputs = [tuple(s) for s in inputs]
+        self.outputs = [tuple(s) for s in outputs]
+        self.params = tuple(params)
+        self._py = None
+        self._sym = None
+        self._loop = None
+        self._warm: set = set()
+        # One output: its shape, () when it is a flat vector (no reshape needed).
+        self._single_out = None
+        if len(self.outputs) == 1:
+            shape = self.outputs[0]
+            self._single_out = "flat" if len(shape) == 1 else shape
+
+    # -- scalar bindings -------------------------------------------------
+    @property
+    def python(self):
+        """The kernel over Python floats: ``python(*params, *components)``."""
+        if self._py is None:
+            self._py = self.bound(math_bindings())
+        return self._py
+
+    def sympy(self, *args):
+        """The kernel over SymPy expressions: ``sympy(*params, *components)``."""
+        if self._sym is None:
+            self._sym = self.bound(sympy_bindings())
+        return self._sym(*args)
+
+    # -- array entry point -------------------------------------------------
+    def __call__(self, *args, out=None, backend=None):
+        """Evaluate over batched arrays.
+
+        Parameters
+        ----------
+        *args
+            The static parameters (Python numbers), then one array per input, of
+            shape ``(..., *input_shape)``; batch shapes broadcast.
+        out : array or tuple of arrays, optional
+            NumPy buffers of shape ``(..., *output_shape)`` to write into.
+        backend : {"numba", "xp", "python"}, optional
+            Force a binding (tests use this to compare them).
+        """
+        if backend is None and out is None:
+            if self.params:
+                single = self._single(args[: len(self.params)], args[len(self.params) :])
+            else:
+                single = self._single((), args)
+            if single is not None:
+                return single
+        nparams = len(self.params)
+        params = args[:nparams]
+        arrays = args[nparams:]
+        if len(arrays) != len(self.inputs):
+            raise TypeError(
+                f"{self.name} takes {len(self.inputs)} array arguments, got {len(arrays)}"
+            )
+        xp = namespace_of(*arrays)
+        if is_numpy(xp) and xp is not np and backend != "xp":
+            xp = np
+        if xp is np:
+            arrays = [np.asarray(a) for a in arrays]
+        batch = self._batch_shape(xp, arrays)
+        if xp is np and backend != "xp":
+            return self._call_numpy(params, arrays, batch, out, backend)
+        return self._call_xp(xp, params, arrays, batch)
+
+    def _single(self, params, arrays):
+        """Fast path for one element of float NumPy arrays (None if not that case)."""
+        if len(arrays) != len(self.inputs):
+            return None
+        comps = []
+        dtype = None
+        for a, trail in zip(arrays, self.inputs):
+            if type(a) is not np.ndarray or a.shape != trail:
+                return None
+            dt = a.dtype
+            if dt is not _F64 and dt is not _F32:
+                return None
+            if dtype is None:
+                dtype = dt
+            elif dt is not dtype:
+                return None
+            comps += a.ravel().tolist()
+        if dtype is None:
+            return None
+        res = self.python(*params, *comps)
+        if self._single_out is not None:
+            o = np.array(res, dtype=dtype)
+            return o if self._single_out == "flat" else o.reshape(self._single_out)
+        outs = []
+        k = 0
+        for s in self.outputs:
+            m = math.prod(s)
+            outs.append(np.array(res[k : k + m], dtype=dtype).reshape(s))
+            k += m
+        return tuple(outs)
+
+    def _batch_shape(self, xp, arrays):
+        shapes = []
+        for k, (a, trail) in enumerate(zip(arrays, self.inputs)):
+            shape = tuple(a.shape)
+            nt = len(trail)
+            if shape[len(shape) - nt :] != trail or len(shape) < nt:
+                from ..errors import ShapeError
+
+                want = "(..., " + ", ".join(map(str, trail)) + ")" if trail else "(...)"
+                raise ShapeError(
+                    f"{self.name}: argument {k} has shape {shape}, expected {want}"
+                )
+            shapes.append(shape[: len(shape) - nt])
+        try:
+            return tuple(np.broadcast_shapes(*shapes))
+        except ValueError:
+            from ..errors import ShapeError
+
+            raise ShapeError(
+                f"{self.name}: batch shapes {shapes} do not broadcast"
+            ) from None
+
+    # -- numpy ---------------------------------------------------------------
+    def _call_numpy(self, params, arrays, batch, out, backend):
+        dtype = float_dtype_of(np, *arrays)
+        n = math.prod(batch)
+        if backend is None:
+            if n == 1:
+                backend = "python"
+            elif numba_backend.available() and (n > NUMBA_MIN or dtype in self._warm):
+                backend = "numba"
+            else:
+                return self._call_xp(np, params, arrays, batch)
+        if backend == "python":
+            return self._call_python(params, arrays, batch, dtype, out)
+        if backend == "numba":
+            return self._call_numba(params, arrays, batch, dtype, out, n)
+        if backend == "xp":  # pragma: no cover - handled by caller
+            return self._call_xp(np, params, arrays, batch)
+        raise ValueError(f"unknown backend {backend!r}")
+
+    def _outputs(self, batch, dtype, out):
+        if out is None:
+            return [np.empty(batch + s, dtype=dtype) for s in self.outputs]
+        outs = [out] if isinstance(out, np.ndarray) else list(out)
+        for o, s in zip(outs, self.outputs):
+            if o.shape != batch + s or not o.flags.c_contiguous:
+                raise ValueError(
+                    f"{self.name}: out= needs a C-contiguous array of shape {batch + s}, "
+                    f"got {o.shape}"
+                )
+        return outs
+
+    def _finish(self, outs):
+        return outs[0] if len(outs) == 1 else tuple(outs)
+
+    def _call_python(self, params, arrays, batch, dtype, out):
+        comps = []
+        for a in arrays:
+            comps += a.ravel().tolist()
+        res = self.python(*params, *comps)
+        outs = self._outputs(batch, dtype, out)
+        k = 0
+        for o, s in zip(outs, self.outputs):
+            m = math.prod(s)
+            o.reshape(-1)[:] = res[k : k + m]
+            k += m
+        return self._finish(outs)
+
+    def _call_numba(self, params, arrays, batch, dtype, out, n):
+        if self._loop is None:
+            self._loop = numba_backend.compile_loop(self)
+        outs = self._outputs(batch, dtype, out)
+        args = list(params)
+        for a, trail in zip(arrays, self.inputs):
+            m = math.prod(trail)
+            size = a.size // m if m else 0
+            if size == n:
+                flat = np.ascontiguousarray(a, dtype=dtype).reshape(n, m)
+                step = 1
+            elif size == 1:
+                flat = np.ascontiguousarray(a, dtype=dtype).reshape(1, m)
+                step = 0
+            else:
+                flat = np.ascontiguousarray(
+                    np.broadcast_to(a, batch + trail), dtype=dtype
+                ).reshape(n, m)
+                step = 1
+            args += [flat, step]
+        for o, s in zip(outs, self.outputs):
+            args.append(o.reshape(n, math.prod(s)))
+        if n:
+            numba_backend.run_loop(self._loop, n, args)
+            self._warm.add(dtype)
+        return self._finish(outs)
+
+    # -- any array namespace --------------------------------------------------
+    def _call_xp(self, xp, params, arrays, batch):
+        dtype = float_dtype_of(xp, *arrays)
+        device = next((device_of(a) for a in arrays if device_of(a) is not None), None)
+        arrays = [xp.asarray(a, dtype=dtype, device=device) for a in arrays]
+        comps = []
+        for a, trail in zip(arrays, self.inputs):
+            if not trail:
+                comps.append(a)
+                continue
+            flat = xp.reshape(a, tuple(a.shape[: a.ndim - len(trail)]) + (-1,))
+            comps += [flat[..., c] for c in range(math.prod(trail))]
+        fn = self.bound(xp_bindings(xp, dtype, device))
+        res = fn(*params, *comps)
+        outs = []
+        k = 0
+        for s in self.outputs:
+            m = math.prod(s)
+            parts = [
+                xp.broadcast_to(xp.asarray(c, dtype=dtype, device=device), batch)
+                for c in res[k : k + m]
+            ]
+            k += m
+            if not s:
+                outs.append(parts[0])
+            else:
+                outs.append(xp.reshape(xp.stack(parts, axis=-1), batch + s))
+        return self._finish(outs)
+
+
+def kernel(inputs, outputs, params=()):
+    """Declare a kernel: trailing shapes of its array inputs and outputs.
+
+    Parameters
+    ----------
+    inputs, outputs : sequence of tuple
+        Trailing shape of each array argument / result, e.g. ``[(4,), (3,)]``.
+    params : sequence of str
+        Names of leading static arguments (Python numbers, same for the batch).
+    """
+
+    def wrap(fn):
+        return Kernel(fn, inputs, outputs, params)
+
+    return wrap

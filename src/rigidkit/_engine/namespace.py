@@ -1,0 +1,125 @@
+"""Which array namespace an input belongs to, and a thin adapter for PyTorch.
+
+NumPy arrays (and lists, tuples, Python numbers) map to ``numpy``; objects that
+implement ``__array_namespace__`` (JAX, CuPy, array-api-strict, NumPy) map to that
+namespace; ``torch.Tensor`` maps to a small adapter, since torch does not yet
+expose the array-API names we use. Nothing here imports torch or jax unless the
+input already is one of their arrays.
+"""
+
+from __future__ import annotations
+
+import types
+
+import numpy as np
+
+_TORCH_NS = None
+
+
+def _torch_namespace():
+    global _TORCH_NS
+    if _TORCH_NS is None:
+        import torch
+
+        def asarray(x, dtype=None, device=None, copy=None):
+            if isinstance(x, torch.Tensor):
+                out = x
+                if dtype is not None and out.dtype != dtype:
+                    out = out.to(dtype)
+                if device is not None and out.device != torch.device(device):
+                    out = out.to(device)
+                return out.clone() if copy else out
+            return torch.as_tensor(x, dtype=dtype, device=device)
+
+        ns = types.SimpleNamespace(
+            __name__="torch",
+            float32=torch.float32,
+            float64=torch.float64,
+            bool=torch.bool,
+            sqrt=torch.sqrt,
+            sin=torch.sin,
+            cos=torch.cos,
+            tan=torch.tan,
+            asin=torch.asin,
+            acos=torch.acos,
+            atan=torch.atan,
+            atan2=torch.atan2,
+            exp=torch.exp,
+            log=torch.log,
+            abs=torch.abs,
+            where=torch.where,
+            maximum=torch.maximum,
+            minimum=torch.minimum,
+            copysign=torch.copysign,
+            isfinite=torch.isfinite,
+            asarray=asarray,
+            stack=lambda arrays, axis=0: torch.stack(tuple(arrays), dim=axis),
+            concat=lambda arrays, axis=0: torch.cat(tuple(arrays), dim=axis),
+            broadcast_to=lambda x, shape: torch.broadcast_to(x, tuple(shape)),
+            reshape=lambda x, shape: torch.reshape(x, tuple(shape)),
+            zeros=lambda shape, dtype=None, device=None: torch.zeros(
+                tuple(shape), dtype=dtype, device=device
+            ),
+            all=lambda x, axis=None: torch.all(x) if axis is None else torch.all(x, dim=axis),
+            any=lambda x, axis=None: torch.any(x) if axis is None else torch.any(x, dim=axis),
+            sum=lambda x, axis=None: torch.sum(x) if axis is None else torch.sum(x, dim=axis),
+            isdtype=lambda dtype, kind: dtype.is_floating_point
+            if kind == "real floating"
+            else False,
+            nonzero=torch.nonzero,
+        )
+        _TORCH_NS = ns
+    return _TORCH_NS
+
+
+def is_torch(x) -> bool:
+    return type(x).__module__.startswith("torch") and hasattr(x, "requires_grad")
+
+
+def namespace_of(*arrays):
+    """The array namespace shared by ``arrays`` (``numpy`` when none is special)."""
+    found = None
+    for a in arrays:
+        if a is None or isinstance(a, (np.ndarray, np.generic, list, tuple, int, float)):
+            continue
+        if is_torch(a):
+            ns = _torch_namespace()
+        elif hasattr(a, "__array_namespace__"):
+            ns = a.__array_namespace__()
+        else:
+            continue
+        if found is None:
+            found = ns
+        elif ns is not found and getattr(ns, "__name__", None) != getattr(
+            found, "__name__", None
+        ):
+            raise TypeError(
+                f"inputs mix array namespaces {found.__name__} and {ns.__name__}"
+            )
+    return np if found is None else found
+
+
+def is_numpy(xp) -> bool:
+    return xp is np or getattr(xp, "__name__", "") in ("numpy", "numpy.array_api")
+
+
+def device_of(x):
+    return getattr(x, "device", None) if not isinstance(x, np.ndarray) else None
+
+
+def float_dtype_of(xp, *arrays):
+    """The floating dtype of a result: that of the inputs, float64 for ints."""
+    if is_numpy(xp):
+        dts = [np.asarray(a).dtype for a in arrays]
+        dt = np.result_type(*dts) if dts else np.dtype(np.float64)
+        if not np.issubdtype(dt, np.floating):
+            return np.dtype(np.float64)
+        if dt == np.float16 or dt.itemsize > 8:
+            return np.dtype(np.float64)
+        return dt
+    dts = [a.dtype for a in arrays if hasattr(a, "dtype")]
+    f64 = xp.float64
+    f32 = xp.float32
+    if dts and all(d == f32 for d in dts):
+        return f32
+    return f64

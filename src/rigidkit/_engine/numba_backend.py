@@ -1,0 +1,164 @@
+"""Generate, compile and cache the fused numba loop of a kernel.
+
+For each kernel we write one small Python module: the primitive prelude, the
+source of the kernel and of every helper it calls, and a loop over the batch that
+reads the components of each input, calls the kernel, and writes each output
+component. The module lives in a cache folder named after a hash of its text, so
+numba's on-disk cache (``cache=True``) is valid across processes and is refreshed
+whenever a kernel changes. The loop is compiled with ``nogil=True``; large batches
+are split over threads (see :func:`run_loop`), so one compile serves the serial and
+the parallel path.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import inspect
+import os
+import sys
+import tempfile
+import textwrap
+import threading
+from concurrent.futures import ThreadPoolExecutor
+
+from .primitives import NUMBA_PRELUDE
+
+_AVAILABLE = None
+_LOCK = threading.Lock()
+_POOL = None
+
+#: A batch at least this long is split over threads (thread hand-off costs ~20 us).
+PARALLEL_MIN = int(os.environ.get("RIGIDKIT_PARALLEL_MIN", "200000"))
+
+
+def available() -> bool:
+    """True when numba can be imported and is not disabled by RIGIDKIT_DISABLE_NUMBA."""
+    global _AVAILABLE
+    if os.environ.get("RIGIDKIT_DISABLE_NUMBA", "") not in ("", "0"):
+        return False
+    if _AVAILABLE is None:
+        try:
+            import numba  # noqa: F401
+
+            _AVAILABLE = True
+        except Exception:  # pragma: no cover - depends on the machine
+            _AVAILABLE = False
+    return _AVAILABLE
+
+
+def _cache_dir() -> str | None:
+    base = os.environ.get("RIGIDKIT_CACHE_DIR") or os.path.join(
+        os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "rigidkit"
+    )
+    path = os.path.join(base, "numba")
+    try:
+        os.makedirs(path, exist_ok=True)
+        probe = os.path.join(path, ".probe")
+        with open(probe, "w"):
+            pass
+        return path
+    except OSError:
+        return None
+
+
+def function_source(fn) -> str:
+    """Source of ``fn`` without decorators, dedented."""
+    src = textwrap.dedent(inspect.getsource(fn))
+    lines = src.splitlines()
+    start = next(i for i, line in enumerate(lines) if line.lstrip().startswith("def "))
+    return "\n".join(lines[start:]) + "\n"
+
+
+def _loop_source(kernel) -> str:
+    nparams = len(kernel.params)
+    args = ["start", "stop"]
+    args += [f"p{k}" for k in range(nparams)]
+    body = []
+    call = [f"p{k}" for k in range(nparams)]
+    for k, shape in enumerate(kernel.inputs):
+        args += [f"a{k}", f"s{k}"]
+        body.append(f"        j{k} = i * s{k}")
+        call += [f"a{k}[j{k}, {c}]" for c in range(_size(shape))]
+    outs = []
+    for k, shape in enumerate(kernel.outputs):
+        args.append(f"o{k}")
+        outs += [(k, c) for c in range(_size(shape))]
+    body.append(f"        r = {kernel.name}({', '.join(call)})")
+    for n, (k, c) in enumerate(outs):
+        body.append(f"        o{k}[i, {c}] = r[{n}]")
+    head = f"@numba.njit(cache=CACHE, nogil=True, error_model='numpy')\ndef loop({', '.join(args)}):\n"
+    return head + "    for i in range(start, stop):\n" + "\n".join(body) + "\n"
+
+
+def _size(shape) -> int:
+    n = 1
+    for s in shape:
+        n *= s
+    return n
+
+
+def module_source(kernel) -> str:
+    parts = [NUMBA_PRELUDE]
+    for dep in kernel.dependencies():
+        parts.append("\n\n@numba.njit(inline='always', error_model='numpy')\n" + function_source(dep.fn))
+    parts.append("\n\n@numba.njit(inline='always', error_model='numpy')\n" + function_source(kernel.fn))
+    parts.append("\n\n" + _loop_source(kernel))
+    return "\n".join(parts)
+
+
+def compile_loop(kernel):
+    """Import (and so compile on first call) the generated module of ``kernel``."""
+    import numba
+
+    src = module_source(kernel)
+    digest = hashlib.sha1((src + numba.__version__).encode()).hexdigest()[:16]
+    modname = f"rigidkit_k_{kernel.name}_{digest}"
+    folder = _cache_dir()
+    with _LOCK:
+        if modname in sys.modules:
+            return sys.modules[modname].loop
+        if folder is None:
+            namespace = {"CACHE": False}
+            exec(compile(src, f"<rigidkit kernel {kernel.name}>", "exec"), namespace)
+            return namespace["loop"]
+        path = os.path.join(folder, modname + ".py")
+        if not os.path.exists(path):
+            fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
+            with os.fdopen(fd, "w") as fh:
+                fh.write("CACHE = True\n" + src)
+            os.replace(tmp, path)
+        spec = importlib.util.spec_from_file_location(modname, path)
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        sys.modules[modname] = module
+        return module.loop
+
+
+def _pool():
+    global _POOL
+    if _POOL is None:
+        _POOL = ThreadPoolExecutor(max_workers=max(1, _ncpu()))
+    return _POOL
+
+
+def _ncpu() -> int:
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover - non-Linux
+        return os.cpu_count() or 1
+
+
+def run_loop(loop, n, args):
+    """Run ``loop(start, stop, *args)`` over ``range(n)``, on all cores if it pays."""
+    workers = _ncpu()
+    if n < PARALLEL_MIN or workers < 2:
+        loop(0, n, *args)
+        return
+    bounds = [n * k // workers for k in range(workers + 1)]
+    futures = [
+        _pool().submit(loop, bounds[k], bounds[k + 1], *args) for k in range(1, workers)
+    ]
+    loop(bounds[0], bounds[1], *args)
+    for f in futures:
+        f.result()

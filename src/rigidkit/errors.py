@@ -1,0 +1,50 @@
+"""Exceptions and warnings raised by rigidkit.
+
+Every error about bad input subclasses :class:`ValueError` and says what was wrong
+and, for batches, at which batch index.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "RigidkitError",
+    "NotARotationError",
+    "NonFiniteError",
+    "ZeroNormError",
+    "ShapeError",
+    "EulerSequenceError",
+    "GimbalLockWarning",
+]
+
+
+class RigidkitError(ValueError):
+    """Base class of every input error raised by rigidkit."""
+
+
+class NotARotationError(RigidkitError):
+    """A matrix is not in SO(3) (or SO(2)) within tolerance."""
+
+
+class NonFiniteError(RigidkitError):
+    """An input holds NaN or infinity."""
+
+
+class ZeroNormError(RigidkitError):
+    """A quaternion or axis has zero norm, so it names no rotation or direction."""
+
+
+class ShapeError(RigidkitError):
+    """An array has the wrong trailing shape."""
+
+
+class EulerSequenceError(RigidkitError):
+    """An Euler sequence string is not one of the 24 accepted forms."""
+
+
+class GimbalLockWarning(UserWarning):
+    """Euler angles were requested at (or numerically at) gimbal lock.
+
+    The returned angles still rebuild the rotation; the split between the first
+    and third angle is then a convention (the third angle is set to zero at
+    exact lock).
+    """
