@@ -16,6 +16,7 @@ from . import conversions as _conv
 from ._engine.namespace import is_numpy, namespace_of
 from ._validate import as_array
 from .errors import ShapeError
+from .group import LieGroup
 
 __all__ = ["Rotation"]
 
@@ -24,7 +25,7 @@ def _numpy_or(x):
     return np.asarray(x) if is_numpy(namespace_of(x)) else x
 
 
-class Rotation:
+class Rotation(LieGroup):
     """A batch of 3D rotations of any shape, one unit quaternion each.
 
     Conventions: Hamilton quaternions ``(w, x, y, z)``; active rotations on column
@@ -44,6 +45,9 @@ class Rotation:
     """
 
     __slots__ = ("_quat",)
+    dof = 3
+    matrix_size = 3
+    point_dim = 3
     __array_priority__ = 1000  # so ndarray @ Rotation defers to us (and fails clearly)
 
     def __init__(self, quat, *, _normalized=False):
@@ -94,7 +98,10 @@ class Rotation:
             r = r * (math.pi / 180.0)
         return cls._wrap(_conv.quat_from_rotvec(r))
 
-    exp = from_rotvec
+    @classmethod
+    def exp(cls, tau):
+        """``exp(hat(tau))`` for rotation vectors ``tau`` (radians), shape (..., 3)."""
+        return cls.from_rotvec(tau)
 
     @classmethod
     def from_axis_angle(cls, axis, angle, *, degrees=False):
@@ -168,7 +175,13 @@ class Rotation:
         r = _conv.rotvec_from_quat(self._quat)
         return r * (180.0 / math.pi) if degrees else r
 
-    log = as_rotvec
+    def log(self):
+        """Rotation vectors (angle in [0, pi]), the inverse of :meth:`exp`."""
+        return self.as_rotvec()
+
+    def adjoint(self):
+        """Adjoint of SO(3): the rotation matrix itself, ``R hat(w) R^T = hat(R w)``."""
+        return self.as_matrix()
 
     def as_axis_angle(self, *, degrees=False):
         """``(axis, angle)``: unit axes (..., 3) and angles (...) in [0, pi].
@@ -226,23 +239,6 @@ class Rotation:
     def inv(self):
         """Inverse rotations (conjugate quaternions)."""
         return Rotation._wrap(_conv.quat_conjugate(self._quat))
-
-    def plus(self, tau, *, side="right"):
-        """``R ⊕ tau``: ``R @ exp(tau)`` (right, body) or ``exp(tau) @ R`` (left, world)."""
-        delta = Rotation.from_rotvec(tau)
-        if side == "right":
-            return self @ delta
-        if side == "left":
-            return delta @ self
-        raise ValueError(f"side must be 'right' or 'left', got {side!r}")
-
-    def minus(self, other, *, side="right"):
-        """``R ⊖ S``: ``log(S^-1 @ R)`` (right) or ``log(R @ S^-1)`` (left), (..., 3)."""
-        if side == "right":
-            return (other.inv() @ self).as_rotvec()
-        if side == "left":
-            return (self @ other.inv()).as_rotvec()
-        raise ValueError(f"side must be 'right' or 'left', got {side!r}")
 
     def approx_equal(self, other, *, atol=1e-8):
         """Elementwise: the angle between the rotations is at most ``atol`` (radians).
