@@ -7,6 +7,8 @@ the index is looked up only once something is wrong.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ._engine.namespace import is_numpy, namespace_of
@@ -15,11 +17,10 @@ from .errors import NonFiniteError, ShapeError
 
 def as_array(x, trail: tuple, what: str):
     """``x`` as an array of its own namespace (NumPy for lists), shape-checked."""
-    xp = namespace_of(x)
-    if is_numpy(xp):
+    if type(x) is not np.ndarray and is_numpy(namespace_of(x)):
         x = np.asarray(x)
-        if x.dtype.kind not in "fiu":
-            raise ShapeError(f"{what}: expected real numbers, got dtype {x.dtype}")
+    if isinstance(x, np.ndarray) and x.dtype.kind not in "fiu":
+        raise ShapeError(f"{what}: expected real numbers, got dtype {x.dtype}")
     nt = len(trail)
     shape = tuple(x.shape)
     if len(shape) < nt or shape[len(shape) - nt :] != trail:
@@ -50,7 +51,12 @@ def where_text(index: tuple) -> str:
 def check_finite(x, trail: tuple, what: str) -> None:
     """Raise :class:`NonFiniteError` if any component of ``x`` is NaN or infinite."""
     if isinstance(x, np.ndarray):
-        if x.dtype.kind != "f" or np.isfinite(x).all():
+        if x.dtype.kind != "f":
+            return
+        if x.size <= 16:  # a ufunc call costs more than this loop for one element
+            if all(map(math.isfinite, x.ravel().tolist())):
+                return
+        elif np.isfinite(x).all():
             return
         bad = ~np.isfinite(x)
     else:

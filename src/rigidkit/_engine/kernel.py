@@ -24,6 +24,7 @@ Dispatch, for ``a = kernel(arrays...)``:
 
 from __future__ import annotations
 
+import ast
 import math
 import os
 import types
@@ -85,12 +86,50 @@ class _Rebindable:
         visit(self.fn)
         return order
 
-    def bound(self, primitives: dict):
-        """This function with ``primitives`` and rebound helpers as its globals."""
+    def bound(self, primitives: dict, *, scalar=False):
+        """This function with ``primitives`` and rebound helpers as its globals.
+
+        ``scalar=True`` (Python floats) first rewrites ``where(c, a, b)`` into
+        ``a if c else b`` (see :func:`_scalar_version`): several times faster,
+        and only the branch taken is evaluated.
+        """
+        make = _scalar_version if scalar else _rebind
         env = dict(primitives)
         for dep in self.dependencies():
-            env[dep.name] = _rebind(dep.fn, env)
-        return _rebind(self.fn, env)
+            env[dep.name] = make(dep.fn, env)
+        return make(self.fn, env)
+
+
+class _InlineBranches(ast.NodeTransformer):
+    """``where(c, a, b)`` -> ``(a if c else b)``; ``maximum``/``minimum`` likewise."""
+
+    def visit_Call(self, node):
+        self.generic_visit(node)
+        if isinstance(node.func, ast.Name) and not node.keywords:
+            name, args = node.func.id, node.args
+            if name == "where" and len(args) == 3:
+                return ast.IfExp(test=args[0], body=args[1], orelse=args[2])
+            if name in ("maximum", "minimum") and len(args) == 2:
+                op = ast.GtE() if name == "maximum" else ast.LtE()
+                a, b = args
+                if isinstance(a, ast.Name) and isinstance(b, ast.Name):
+                    test = ast.Compare(left=a, ops=[op], comparators=[b])
+                    return ast.IfExp(test=test, body=a, orelse=b)
+        return node
+
+
+def _scalar_version(fn, env: dict):
+    """``fn`` compiled with branches inlined for Python floats (falls back to ``fn``)."""
+    try:
+        from .numba_backend import function_source
+
+        tree = ast.parse(function_source(fn))
+    except (OSError, TypeError):  # no source (defined interactively): plain rebind
+        return _rebind(fn, env)
+    tree = ast.fix_missing_locations(_InlineBranches().visit(tree))
+    namespace = dict(env)
+    exec(compile(tree, f"<rigidkit scalar {fn.__name__}>", "exec"), namespace)
+    return namespace[fn.__name__]
 
 
 def _is_builtin(name: str) -> bool:
@@ -108,7 +147,7 @@ class Helper(_Rebindable):
 
     def __call__(self, *args):
         if self._py is None:
-            self._py = self.bound(math_bindings())
+            self._py = self.bound(math_bindings(), scalar=True)
         return self._py(*args)
 
 
@@ -131,8 +170,14 @@ class Kernel(_Rebindable):
         self._sym = None
         self._loop = None
         self._warm: set = set()
+        self._xp_cache: dict = {}
         # One output: its shape, () when it is a flat vector (no reshape needed).
         self._single_out = None
+        self._single_slices = []
+        start = 0
+        for shape in self.outputs:
+            self._single_slices.append((start, start + math.prod(shape), shape))
+            start += math.prod(shape)
         if len(self.outputs) == 1:
             shape = self.outputs[0]
             self._single_out = "flat" if len(shape) == 1 else shape
@@ -142,7 +187,7 @@ class Kernel(_Rebindable):
     def python(self):
         """The kernel over Python floats: ``python(*params, *components)``."""
         if self._py is None:
-            self._py = self.bound(math_bindings())
+            self._py = self.bound(math_bindings(), scalar=True)
         return self._py
 
     def sympy(self, *args):
@@ -212,12 +257,15 @@ class Kernel(_Rebindable):
         if self._single_out is not None:
             o = np.array(res, dtype=dtype)
             return o if self._single_out == "flat" else o.reshape(self._single_out)
+        flat = np.array(res, dtype=dtype)
         outs = []
-        k = 0
-        for s in self.outputs:
-            m = math.prod(s)
-            outs.append(np.array(res[k : k + m], dtype=dtype).reshape(s))
-            k += m
+        for a, b, s in self._single_slices:
+            if not s:
+                outs.append(flat[a])  # a NumPy scalar: shape (), cheaper than 0-d
+            elif len(s) == 1:
+                outs.append(flat[a:b])
+            else:
+                outs.append(flat[a:b].reshape(s))
         return tuple(outs)
 
     def _batch_shape(self, xp, arrays):
@@ -328,7 +376,10 @@ class Kernel(_Rebindable):
                 continue
             flat = xp.reshape(a, tuple(a.shape[: a.ndim - len(trail)]) + (-1,))
             comps += [flat[..., c] for c in range(math.prod(trail))]
-        fn = self.bound(xp_bindings(xp, dtype, device))
+        key = (getattr(xp, "__name__", id(xp)), str(dtype), str(device))
+        fn = self._xp_cache.get(key)
+        if fn is None:
+            fn = self._xp_cache[key] = self.bound(xp_bindings(xp, dtype, device))
         res = fn(*params, *comps)
         outs = []
         k = 0

@@ -101,8 +101,8 @@ def _size(shape) -> int:
 def module_source(kernel) -> str:
     parts = [NUMBA_PRELUDE]
     for dep in kernel.dependencies():
-        parts.append("\n\n@numba.njit(inline='always', error_model='numpy')\n" + function_source(dep.fn))
-    parts.append("\n\n@numba.njit(inline='always', error_model='numpy')\n" + function_source(kernel.fn))
+        parts.append("\n\n@numba.njit(error_model='numpy')\n" + function_source(dep.fn))
+    parts.append("\n\n@numba.njit(error_model='numpy')\n" + function_source(kernel.fn))
     parts.append("\n\n" + _loop_source(kernel))
     return "\n".join(parts)
 
