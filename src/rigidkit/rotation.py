@@ -93,10 +93,9 @@ class Rotation(LieGroup):
     @classmethod
     def from_rotvec(cls, rotvec, *, degrees=False):
         """From rotation vectors ``angle * axis``, shape (..., 3)."""
-        r = as_array(rotvec, (3,), "rotation vector")
         if degrees:
-            r = r * (math.pi / 180.0)
-        return cls._wrap(_conv.quat_from_rotvec(r))
+            rotvec = as_array(rotvec, (3,), "rotation vector") * (math.pi / 180.0)
+        return cls._wrap(_conv.quat_from_rotvec(rotvec))
 
     @classmethod
     def exp(cls, tau):
@@ -222,8 +221,8 @@ class Rotation(LieGroup):
         """``R1 @ R2`` composes (``R2`` first); ``R @ v`` rotates vectors (..., 3)."""
         if isinstance(other, Rotation):
             return Rotation._wrap(_conv.quat_multiply(self._quat, other._quat))
-        if hasattr(other, "_quat") or hasattr(other, "__rmatmul_rigidkit__"):
-            return NotImplemented
+        if isinstance(other, LieGroup):
+            return NotImplemented  # e.g. Rotation @ Transform: the other side decides
         return self.apply(other)
 
     def __rmatmul__(self, other):

@@ -25,6 +25,7 @@ Dispatch, for ``a = kernel(arrays...)``:
 from __future__ import annotations
 
 import ast
+import builtins
 import math
 import os
 import types
@@ -95,6 +96,7 @@ class _Rebindable:
         """
         make = _scalar_version if scalar else _rebind
         env = dict(primitives)
+        env["__builtins__"] = builtins
         for dep in self.dependencies():
             env[dep.name] = make(dep.fn, env)
         return make(self.fn, env)
@@ -133,8 +135,6 @@ def _scalar_version(fn, env: dict):
 
 
 def _is_builtin(name: str) -> bool:
-    import builtins
-
     return hasattr(builtins, name)
 
 
@@ -294,6 +294,8 @@ class Kernel(_Rebindable):
     def _call_numpy(self, params, arrays, batch, out, backend):
         dtype = float_dtype_of(np, *arrays)
         n = math.prod(batch)
+        if n == 0:
+            return self._finish(self._outputs(batch, dtype, out))
         if backend is None:
             if n == 1:
                 backend = "python"
@@ -374,7 +376,7 @@ class Kernel(_Rebindable):
             if not trail:
                 comps.append(a)
                 continue
-            flat = xp.reshape(a, tuple(a.shape[: a.ndim - len(trail)]) + (-1,))
+            flat = xp.reshape(a, tuple(a.shape[: a.ndim - len(trail)]) + (math.prod(trail),))
             comps += [flat[..., c] for c in range(math.prod(trail))]
         key = (getattr(xp, "__name__", id(xp)), str(dtype), str(device))
         fn = self._xp_cache.get(key)

@@ -149,10 +149,31 @@ def _ncpu() -> int:
         return os.cpu_count() or 1
 
 
+def _workers() -> int:
+    """Threads for a large batch: ``RIGIDKIT_NUM_THREADS``, else the idle cores.
+
+    Splitting pays only when the other cores are free: on a machine whose 1-minute
+    load already fills them, a second thread just competes for the same core.
+    """
+    env = os.environ.get("RIGIDKIT_NUM_THREADS")
+    if env:
+        return max(1, int(env))
+    n = _ncpu()
+    try:
+        # The load includes the thread running this call; the rest is other work.
+        others = max(0.0, os.getloadavg()[0] - 1.0)
+    except OSError:  # pragma: no cover - no load average on this platform
+        others = 0.0
+    return max(1, min(n, int(n - others + 0.5)))
+
+
 def run_loop(loop, n, args):
     """Run ``loop(start, stop, *args)`` over ``range(n)``, on all cores if it pays."""
-    workers = _ncpu()
-    if n < PARALLEL_MIN or workers < 2:
+    if n < PARALLEL_MIN:
+        loop(0, n, *args)
+        return
+    workers = _workers()
+    if workers < 2:
         loop(0, n, *args)
         return
     bounds = [n * k // workers for k in range(workers + 1)]
