@@ -111,7 +111,8 @@ def quat_xyzw_from_wxyz(q):
 
 def default_atol(dtype) -> float:
     """Tolerance of :func:`quat_from_matrix`: 1e-6 for float64, 1e-4 for float32."""
-    return 1e-4 if dtype == np.float32 else 1e-6
+    # str() works for every namespace's dtype (numpy, torch, array-api-strict).
+    return 1e-4 if str(dtype).endswith("float32") else 1e-6
 
 
 def quat_from_matrix(matrix, *, atol=None, orthonormalize=False):

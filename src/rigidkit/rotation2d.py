@@ -1,0 +1,286 @@
+"""``Rotation2D``: a batch of planar rotations (SO(2)), stored as unit complex numbers.
+
+Conventions: a rotation by ``θ`` (radians, counter-clockwise) is ``e^{iθ}`` and
+the matrix ``exp(θ J) = [[cos θ, -sin θ], [sin θ, cos θ]]``,
+``J = [[0, -1], [1, 0]]``; rotations are active and act on column vectors,
+``p_A = A_R_B @ p_B``; ``R1 @ R2`` applies ``R2`` first. Tangent vectors are
+1-vectors ``(θ,)``, shape (..., 1).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from . import so2 as _so2
+from ._engine.namespace import is_numpy, is_torch, namespace_of
+from ._validate import as_array, check_finite
+from .errors import ShapeError
+from .group import LieGroup
+from .kernels import so2 as _k
+
+__all__ = ["Rotation2D"]
+
+
+def _to_np(a):
+    return a.detach().cpu().numpy() if hasattr(a, "detach") else np.asarray(a)
+
+
+def _batch_shape(shape) -> tuple:
+    return (shape,) if isinstance(shape, int) else tuple(shape)
+
+
+class _Batched:
+    """Container protocol of a class holding one array ``_data`` of shape (..., width)."""
+
+    __slots__ = ()
+    _width: int
+
+    @classmethod
+    def _wrap(cls, data):
+        obj = cls.__new__(cls)
+        obj._data = data
+        return obj
+
+    @property
+    def shape(self) -> tuple:
+        """Batch shape (``()`` for a single element)."""
+        return tuple(self._data.shape[:-1])
+
+    @property
+    def dtype(self):
+        """Floating dtype of the stored array."""
+        return self._data.dtype
+
+    @property
+    def single(self) -> bool:
+        """True for a single element (batch shape ``()``)."""
+        return self._data.ndim == 1
+
+    def __len__(self):
+        if self.single:
+            raise TypeError(f"a single {type(self).__name__} has no len()")
+        return self._data.shape[0]
+
+    def __getitem__(self, index):
+        if self.single:
+            raise TypeError(f"a single {type(self).__name__} cannot be indexed")
+        if not isinstance(index, tuple):
+            index = (index,)
+        # The trailing component axis is kept whole; an explicit ``...`` makes the
+        # index complete, as the array API requires.
+        if not any(i is Ellipsis for i in index):
+            index = index + (Ellipsis,)
+        return self._wrap(self._data[index + (slice(None),)])
+
+    def __iter__(self):
+        if self.single:
+            raise TypeError(f"a single {type(self).__name__} is not iterable")
+        for k in range(len(self)):
+            yield self[k]
+
+    def reshape(self, *shape):
+        """The same elements with another batch shape."""
+        if len(shape) == 1 and isinstance(shape[0], (tuple, list)):
+            shape = tuple(shape[0])
+        xp = namespace_of(self._data)
+        return self._wrap(xp.reshape(self._data, tuple(shape) + (self._width,)))
+
+    @classmethod
+    def concatenate(cls, items):
+        """Join 1-D batches (or single elements) along the first axis."""
+        arrays = [x._data if x._data.ndim > 1 else x._data[None] for x in items]
+        if not arrays:
+            raise ShapeError(f"concatenate needs at least one {cls.__name__}")
+        return cls._wrap(namespace_of(*arrays).concat(arrays, axis=0))
+
+    def __reduce__(self):
+        return (type(self)._wrap, (self._data,))
+
+    def __eq__(self, other):  # identity of objects; use approx_equal to compare
+        return NotImplemented if not isinstance(other, type(self)) else self is other
+
+    __hash__ = object.__hash__
+
+
+class Rotation2D(_Batched, LieGroup):
+    """A batch of planar rotations of any shape, one unit complex number each.
+
+    Stored as ``(cos θ, sin θ)``, shape (..., 2). Rotations are active and act on
+    column vectors, ``p_A = A_R_B @ p_B``; ``A_R_C = A_R_B @ B_R_C``. Tangent
+    vectors (``exp``, ``log``, ``plus``, ``minus``) have shape (..., 1); the
+    array namespace (NumPy, torch, ...) and dtype of the input are kept.
+
+    Parameters
+    ----------
+    cos_sin : array_like, shape (..., 2)
+        ``(re, im)`` of nonzero complex numbers, normalised here.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import rigidkit as rk
+    >>> A_R_B = rk.Rotation2D.from_angle(90.0, degrees=True)
+    >>> np.round(A_R_B @ np.array([1.0, 0.0]), 12) + 0.0
+    array([0., 1.])
+    >>> A_R_B.as_complex().round(12) + 0.0
+    np.complex128(1j)
+    >>> float(A_R_B.angle)
+    1.5707963267948966
+    """
+
+    __slots__ = ("_data",)
+    _width = 2
+    dof = 1
+    matrix_size = 2
+    point_dim = 2
+    __array_priority__ = 1000  # so ndarray @ Rotation2D defers to us (and fails clearly)
+
+    def __init__(self, cos_sin):
+        self._data = _so2.complex_normalize(cos_sin, what="(cos, sin) pair")
+
+    # -- construction -------------------------------------------------------
+    @classmethod
+    def from_angle(cls, angle, *, degrees=False):
+        """Rotations by ``angle`` (counter-clockwise), shape (...).
+
+        >>> Rotation2D.from_angle([0.0, -np.pi]).angle
+        array([0.        , 3.14159265])
+        """
+        t = as_array(angle, (), "angle")
+        check_finite(t, (), "angle")
+        if degrees:
+            t = t * (math.pi / 180.0)
+        return cls._wrap(_k.complex_from_angle(t[..., None]))
+
+    @classmethod
+    def exp(cls, tau):
+        """``exp(θ J)`` for tangent vectors ``(θ,)``, shape (..., 1), radians."""
+        t = as_array(tau, (1,), "so(2) tangent vector (shape (..., 1))")
+        check_finite(t, (1,), "so(2) tangent vector")
+        return cls._wrap(_k.complex_from_angle(t))
+
+    @classmethod
+    def from_complex(cls, z):
+        """From nonzero complex numbers ``r e^{iθ}``, shape (...), normalised.
+
+        NumPy (or Python) complex numbers, or a complex torch tensor.
+
+        >>> float(Rotation2D.from_complex(2j).angle)
+        1.5707963267948966
+        """
+        if is_torch(z):
+            import torch
+
+            if not torch.is_complex(z):
+                raise ShapeError(f"from_complex: expected a complex tensor, got {z.dtype}")
+            pairs = torch.stack([z.real, z.imag], dim=-1)
+        else:
+            z = np.asarray(z)
+            if z.dtype.kind != "c":
+                raise ShapeError(
+                    f"from_complex: expected complex numbers, got dtype {z.dtype}; "
+                    "use Rotation2D(cos_sin) for (..., 2) real pairs"
+                )
+            pairs = np.stack([z.real, z.imag], axis=-1)
+        return cls._wrap(_so2.complex_normalize(pairs))
+
+    @classmethod
+    def from_matrix(cls, matrix, *, atol=None, orthonormalize=False):
+        """From rotation matrices, shape (..., 2, 2), validated.
+
+        Raises :class:`~rigidkit.NotARotationError` (naming the batch index) when a
+        matrix is not a rotation within ``atol``; ``orthonormalize=True`` takes the
+        nearest rotation instead. See :func:`rigidkit.so2.complex_from_matrix`.
+        """
+        return cls._wrap(
+            _so2.complex_from_matrix(matrix, atol=atol, orthonormalize=orthonormalize)
+        )
+
+    @classmethod
+    def identity(cls, shape=(), *, dtype=None):
+        """Identity rotations of batch ``shape`` (``()`` for one)."""
+        z = np.zeros(_batch_shape(shape) + (2,), dtype=dtype or np.float64)
+        z[..., 0] = 1.0
+        return cls._wrap(z)
+
+    @classmethod
+    def random(cls, shape=(), rng=None, *, dtype=None):
+        """Uniformly distributed (Haar) rotations: angles uniform in [-pi, pi).
+
+        ``rng`` is a :class:`numpy.random.Generator` or a seed.
+        """
+        rng = np.random.default_rng(rng)
+        t = rng.uniform(-math.pi, math.pi, _batch_shape(shape) + (1,))
+        z = _k.complex_from_angle(t)
+        return cls._wrap(z.astype(dtype) if dtype is not None else z)
+
+    # -- representations ------------------------------------------------------
+    def as_complex(self):
+        """Unit complex numbers ``e^{iθ}``, shape (...).
+
+        A complex NumPy array (complex64 for float32) for NumPy storage, a complex
+        tensor for torch; for other namespaces ``cos + 1j * sin``.
+        """
+        c = self._data[..., 0]
+        s = self._data[..., 1]
+        if is_torch(self._data):
+            import torch
+
+            return torch.complex(c, s)
+        if is_numpy(namespace_of(self._data)):
+            out = np.empty(c.shape, dtype=np.result_type(c.dtype, np.complex64))
+            out.real = c
+            out.imag = s
+            return out
+        return c + s * 1j
+
+    def as_matrix(self, *, out=None):
+        """Rotation matrices ``[[c, -s], [s, c]]``, shape (..., 2, 2)."""
+        return _k.matrix_from_complex(self._data, out=out)
+
+    @property
+    def angle(self):
+        """Rotation angle in (-pi, pi], shape (...), radians."""
+        return self.log()[..., 0]
+
+    def log(self):
+        """Tangent vectors ``(θ,)``, θ in (-pi, pi], shape (..., 1); see :meth:`exp`."""
+        return _k.angle_from_complex(self._data)
+
+    def adjoint(self):
+        """``Ad = [[1]]``, shape (..., 1, 1): SO(2) is commutative."""
+        return _k.adjoint_from_complex(self._data)
+
+    # -- group operations ----------------------------------------------------------
+    def __matmul__(self, other):
+        """``R1 @ R2`` composes (``R2`` first); ``R @ p`` rotates points (..., 2)."""
+        if isinstance(other, Rotation2D):
+            return Rotation2D._wrap(_k.complex_multiply(self._data, other._data))
+        if isinstance(other, LieGroup) or hasattr(other, "__rmatmul_rigidkit__"):
+            return NotImplemented
+        return self.apply(other)
+
+    def __rmatmul__(self, other):
+        raise TypeError(
+            "array @ Rotation2D is not defined; rotate points with R @ p or R.apply(p)"
+        )
+
+    def apply(self, points, *, out=None):
+        """Rotate points, shape (..., 2) broadcasting with the rotation's shape."""
+        p = as_array(points, (2,), "points")
+        return _k.complex_apply(self._data, p, out=out)
+
+    def inv(self):
+        """Inverse rotations (conjugate complex numbers)."""
+        return Rotation2D._wrap(_k.complex_conjugate(self._data))
+
+    def approx_equal(self, other, *, atol=1e-8):
+        """Elementwise: the angle between the rotations is at most ``atol`` (radians)."""
+        return _k.angle_between(self._data, other._data) <= atol
+
+    def __repr__(self):
+        if self.single:
+            return f"Rotation2D.from_angle({float(_to_np(self.angle)):.6g})"
+        return f"Rotation2D(shape={self.shape}, dtype={self.dtype})"

@@ -1,0 +1,215 @@
+"""The Lie group SO(2) in functional form (arrays in, arrays out).
+
+A planar rotation by ``θ`` (radians, counter-clockwise) is the matrix
+``exp(θ J) = [[cos θ, -sin θ], [sin θ, cos θ]]``, ``J = [[0, -1], [1, 0]]``, or
+the unit complex number ``e^{iθ}``. Tangent vectors are 1-vectors ``(θ,)``, shape
+(..., 1), like the ``(..., dof)`` tangent vectors of every other group, so that
+``adjoint(R) @ tau`` and the Jacobians compose as matrices. SO(2) is commutative:
+the adjoint and all Jacobians are ``[[1]]`` and the bracket is 0.
+
+Every function is batched over leading axes and keeps the array namespace and
+dtype of its input.
+
+>>> import numpy as np
+>>> R = exp(np.array([np.pi / 2]))
+>>> np.round(R, 12) + 0.0
+array([[ 0., -1.],
+       [ 1.,  0.]])
+>>> log(R)
+array([1.57079633])
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._engine.namespace import namespace_of
+from ._validate import as_array, batch_index, check_finite, where_text
+from .conversions import default_atol
+from .errors import NotARotationError, ZeroNormError
+from .kernels import so2 as _k
+
+__all__ = [
+    "hat",
+    "vee",
+    "exp",
+    "log",
+    "adjoint",
+    "ad",
+    "bracket",
+    "left_jacobian",
+    "right_jacobian",
+    "left_jacobian_inverse",
+    "right_jacobian_inverse",
+    "complex_from_matrix",
+    "complex_normalize",
+]
+
+
+def _tangent(w, what="so(2) vector"):
+    w = as_array(w, (1,), what)
+    check_finite(w, (1,), what)
+    return w
+
+
+def hat(w):
+    """``hat(θ) = θ J = [[0, -θ], [θ, 0]]``: shape (..., 1) -> (..., 2, 2).
+
+    >>> hat([2.0])
+    array([[ 0., -2.],
+           [ 2.,  0.]])
+    """
+    return _k.hat(as_array(w, (1,), "so(2) vector"))
+
+
+def vee(W):
+    """Inverse of :func:`hat` (skew part ``(W - W^T)/2``): (..., 2, 2) -> (..., 1)."""
+    return _k.vee(as_array(W, (2, 2), "so(2) matrix"))
+
+
+def exp(w):
+    """Rotation matrices ``expm(hat(θ))``: shape (..., 1) radians -> (..., 2, 2).
+
+    See Also
+    --------
+    log
+    """
+    return _k.matrix_from_angle(_tangent(w, "rotation angle"))
+
+
+def log(R, *, atol=None):
+    """Angle in (-pi, pi] of rotation matrices, validated: (..., 2, 2) -> (..., 1).
+
+    Parameters
+    ----------
+    R : array_like, shape (..., 2, 2)
+    atol : float, optional
+        Tolerance of the SO(2) check, see :func:`complex_from_matrix`.
+
+    See Also
+    --------
+    exp
+    """
+    return _k.angle_from_complex(complex_from_matrix(R, atol=atol))
+
+
+def adjoint(R, *, atol=None):
+    """``Ad(R) = [[1]]`` of rotation matrices (validated): (..., 2, 2) -> (..., 1, 1)."""
+    return _k.adjoint_from_complex(complex_from_matrix(R, atol=atol))
+
+
+def ad(w):
+    """Small adjoint ``ad(θ) = [[0]]``: (..., 1) -> (..., 1, 1)."""
+    return _k.ad(_tangent(w))
+
+
+def bracket(u, w):
+    """Lie bracket ``[u, w] = 0`` (so(2) is abelian): (..., 1) -> (..., 1)."""
+    return _k.bracket(_tangent(u), _tangent(w))
+
+
+def left_jacobian(w):
+    """Left Jacobian ``[[1]]`` (``exp(θ + δ) = exp(δ) exp(θ)``): (..., 1) -> (..., 1, 1)."""
+    return _k.jacobian(_tangent(w))
+
+
+def right_jacobian(w):
+    """Right Jacobian ``[[1]]``: ``exp(θ + δ) = exp(θ) exp(δ)`` exactly."""
+    return _k.jacobian(_tangent(w))
+
+
+def left_jacobian_inverse(w):
+    """Inverse of :func:`left_jacobian`: ``[[1]]``."""
+    return _k.jacobian(_tangent(w))
+
+
+def right_jacobian_inverse(w):
+    """Inverse of :func:`right_jacobian`: ``[[1]]``."""
+    return _k.jacobian(_tangent(w))
+
+
+def complex_normalize(z, *, what="complex number"):
+    """Unit ``(cos θ, sin θ)`` pairs of nonzero ``(re, im)`` pairs, shape (..., 2).
+
+    Raises
+    ------
+    NonFiniteError, ZeroNormError
+        For NaN/inf components or a zero pair, naming the batch index.
+    """
+    z = as_array(z, (2,), what)
+    check_finite(z, (2,), what)
+    unit, norm = _k.complex_normalize(z)
+    zero = norm == 0.0
+    if bool(namespace_of(norm).any(zero)):
+        raise ZeroNormError(
+            f"{what} is zero {where_text(batch_index(zero))}; it names no rotation"
+        )
+    return unit
+
+
+def complex_from_matrix(matrix, *, atol=None, orthonormalize=False):
+    """Unit complex numbers ``(cos θ, sin θ)`` of 2x2 rotation matrices, validated.
+
+    Parameters
+    ----------
+    matrix : array_like, shape (..., 2, 2)
+        Active rotation matrices acting on column vectors.
+    atol : float, optional
+        Largest accepted ``max(|R^T R - I|, |det R - 1|)``; default 1e-6 (float64)
+        or 1e-4 (float32).
+    orthonormalize : bool
+        Instead of raising, take the nearest rotation in Frobenius norm.
+
+    Returns
+    -------
+    array, shape (..., 2)
+
+    Raises
+    ------
+    NonFiniteError
+        NaN or inf anywhere.
+    NotARotationError
+        A matrix is not a rotation within ``atol`` (a reflection, a scaling, a
+        shear), naming the first such batch index and why.
+    """
+    m = as_array(matrix, (2, 2), "rotation matrix")
+    check_finite(m, (2, 2), "rotation matrix")
+    z, norm, err = _k.complex_from_matrix(m)
+    check_rotation_block(m, norm, err, atol=atol, orthonormalize=orthonormalize)
+    return z
+
+
+def check_rotation_block(m, norm, err, *, atol, orthonormalize, what="matrix"):
+    """Raise :class:`NotARotationError` for a 2x2 block (``m[..., :2, :2]``) that
+    is not a rotation (``err > atol``), or, with ``orthonormalize``, that has no
+    unique nearest rotation (``norm == 0``)."""
+    xp = namespace_of(err)
+    if orthonormalize:
+        bad = norm == 0.0
+        if bool(xp.any(bad)):
+            raise NotARotationError(
+                f"{what} {where_text(batch_index(bad))} has no unique nearest rotation "
+                "(m00 + m11 = m10 - m01 = 0, e.g. a reflection)"
+            )
+        return
+    tol = default_atol(getattr(err, "dtype", "float64")) if atol is None else atol
+    bad = err > tol
+    if bool(xp.any(bad)):
+        idx = batch_index(bad)
+        raise NotARotationError(
+            f"{what} {where_text(idx)} is not a rotation: {_why(m, idx)} "
+            f"(tolerance {tol:g}; pass orthonormalize=True for the nearest rotation)"
+        )
+
+
+def _why(m, idx) -> str:
+    a = np.asarray(m.detach().cpu().numpy() if hasattr(m, "detach") else m)[idx]
+    a = a[:2, :2].astype(np.float64)
+    det = float(np.linalg.det(a))
+    dev = float(np.abs(a.T @ a - np.eye(2)).max())
+    if det < 0:
+        return f"det = {det:.6g} < 0 (a reflection)"
+    sv = np.linalg.svd(a, compute_uv=False)
+    if np.abs(sv - sv.mean()).max() < 1e-3 * max(sv.max(), 1e-300):
+        return f"it scales by {sv.mean():.6g} (|R^T R - I| = {dev:.3g})"
+    return f"|R^T R - I| = {dev:.3g}, singular values {np.round(sv, 6).tolist()}"

@@ -1,0 +1,194 @@
+"""``Transform2D``: a batch of planar rigid motions (SE(2)).
+
+Conventions: ``A_T_B`` maps points of frame B to frame A, ``p_A = R p_B + t``, as
+the matrix ``[[R, t], [0, 0, 1]]`` acting on ``[p; 1]``; ``T1 @ T2`` applies ``T2``
+first. Twists are ordered ``(v, ω) = (vx, vy, ω)`` as in 3D. Stored as
+``(cos θ, sin θ, tx, ty)``, shape (..., 4).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import se2 as _se2
+from ._engine.namespace import float_dtype_of, namespace_of
+from ._validate import as_array, check_finite
+from .group import LieGroup
+from .kernels import se2 as _k
+from .rotation2d import Rotation2D, _batch_shape, _Batched, _to_np
+
+__all__ = ["Transform2D"]
+
+
+class Transform2D(_Batched, LieGroup):
+    """A batch of planar rigid motions ``p -> R p + t`` of any batch shape.
+
+    Parameters
+    ----------
+    rotation : Rotation2D, optional
+        Rotation part (identity when omitted).
+    translation : array_like, shape (..., 2), optional
+        Translation part (zero when omitted). The two batch shapes broadcast.
+
+    Notes
+    -----
+    ``A_T_C = A_T_B @ B_T_C`` applies ``B_T_C`` first; ``A_T_B @ p_B`` gives
+    ``p_A``. Tangent vectors are twists ``(vx, vy, ω)``, shape (..., 3), with
+    ``hat(ξ) = [[0, -ω, vx], [ω, 0, vy], [0, 0, 0]]``. The array namespace and
+    dtype of the inputs are kept.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import rigidkit as rk
+    >>> A_T_B = rk.Transform2D(
+    ...     rotation=rk.Rotation2D.from_angle(90.0, degrees=True), translation=[1.0, 2.0]
+    ... )
+    >>> np.round(A_T_B @ np.array([1.0, 0.0]), 12) + 0.0
+    array([1., 3.])
+    >>> np.round((A_T_B @ A_T_B.inv()).as_matrix(), 12) + 0.0
+    array([[1., 0., 0.],
+           [0., 1., 0.],
+           [0., 0., 1.]])
+    """
+
+    __slots__ = ("_data",)
+    _width = 4
+    dof = 3
+    matrix_size = 3
+    point_dim = 2
+    __array_priority__ = 1000  # so ndarray @ Transform2D defers to us (and fails clearly)
+
+    def __init__(self, rotation=None, translation=None):
+        if rotation is not None and not isinstance(rotation, Rotation2D):
+            raise TypeError(f"rotation must be a Rotation2D, got {type(rotation).__name__}")
+        if translation is None:
+            cs = Rotation2D.identity()._data if rotation is None else rotation._data
+            self._data = namespace_of(cs).concat([cs, cs * 0.0], axis=-1)
+            return
+        t = as_array(translation, (2,), "translation")
+        check_finite(t, (2,), "translation")
+        xp = namespace_of(t)
+        if rotation is None:
+            zero = t[..., :1] * 0.0
+            cs = xp.concat([zero + 1.0, zero], axis=-1)
+        else:
+            cs = rotation._data
+            xp = namespace_of(cs, t)
+        dtype = float_dtype_of(xp, cs, t)
+        cs = xp.asarray(cs, dtype=dtype)
+        t = xp.asarray(t, dtype=dtype)
+        batch = tuple(np.broadcast_shapes(tuple(cs.shape[:-1]), tuple(t.shape[:-1])))
+        self._data = xp.concat(
+            [xp.broadcast_to(cs, batch + (2,)), xp.broadcast_to(t, batch + (2,))],
+            axis=-1,
+        )
+
+    # -- construction -------------------------------------------------------
+    @classmethod
+    def from_matrix(cls, matrix, *, atol=None, orthonormalize=False):
+        """From homogeneous matrices ``[[R, t], [0, 0, 1]]``, shape (..., 3, 3), validated.
+
+        Raises :class:`~rigidkit.NotARotationError` (naming the batch index) when the
+        bottom row is not ``[0, 0, 1]`` or ``R`` is not a rotation within ``atol``;
+        ``orthonormalize=True`` replaces ``R`` by its nearest rotation. See
+        :func:`rigidkit.se2.pose_from_matrix`.
+        """
+        return cls._wrap(
+            _se2.pose_from_matrix(matrix, atol=atol, orthonormalize=orthonormalize)
+        )
+
+    @classmethod
+    def exp(cls, tau):
+        """``expm(hat(ξ))`` for twists ``ξ = (vx, vy, ω)``, shape (..., 3).
+
+        ``R = exp(ω J)``, ``t = V(ω) v`` (see :func:`rigidkit.se2.exp`).
+        """
+        xi = as_array(tau, (3,), "se(2) twist")
+        check_finite(xi, (3,), "se(2) twist")
+        return cls._wrap(_k.pose_from_twist(xi))
+
+    @classmethod
+    def identity(cls, shape=(), *, dtype=None):
+        """Identity motions of batch ``shape`` (``()`` for one)."""
+        pose = np.zeros(_batch_shape(shape) + (4,), dtype=dtype or np.float64)
+        pose[..., 0] = 1.0
+        return cls._wrap(pose)
+
+    @classmethod
+    def random(cls, shape=(), rng=None, *, dtype=None):
+        """Random motions: Haar rotations and standard normal translations.
+
+        ``rng`` is a :class:`numpy.random.Generator` or a seed.
+        """
+        rng = np.random.default_rng(rng)
+        shape = _batch_shape(shape)
+        rot = Rotation2D.random(shape, rng)
+        pose = np.concatenate([rot._data, rng.standard_normal(shape + (2,))], axis=-1)
+        return cls._wrap(pose.astype(dtype) if dtype is not None else pose)
+
+    # -- parts and representations ---------------------------------------------
+    @property
+    def rotation(self) -> Rotation2D:
+        """The rotation part, a :class:`Rotation2D` of the same batch shape."""
+        return Rotation2D._wrap(self._data[..., :2])
+
+    @property
+    def translation(self):
+        """The translation part ``t``, shape (..., 2)."""
+        return self._data[..., 2:]
+
+    def as_matrix(self, *, out=None):
+        """Homogeneous matrices ``[[c, -s, tx], [s, c, ty], [0, 0, 1]]``, (..., 3, 3)."""
+        return _k.matrix_from_pose(self._data, out=out)
+
+    def log(self):
+        """Twists ``(vx, vy, ω)``, ω in (-pi, pi], shape (..., 3); see :meth:`exp`."""
+        return _k.twist_from_pose(self._data)
+
+    def adjoint(self):
+        """``Ad = [[R, (ty, -tx)^T], [0, 0, 1]]``, shape (..., 3, 3), for ``(v, ω)``.
+
+        ``T exp(ξ) T^-1 = exp(Ad ξ)``.
+        """
+        return _k.adjoint_from_pose(self._data)
+
+    # -- group operations ----------------------------------------------------------
+    def __matmul__(self, other):
+        """``T1 @ T2`` composes (``T2`` first; ``T2`` may be a Rotation2D);
+        ``T @ p`` maps points (..., 2)."""
+        if isinstance(other, Transform2D):
+            return Transform2D._wrap(_k.pose_multiply(self._data, other._data))
+        if isinstance(other, Rotation2D):
+            return self @ Transform2D(rotation=other)
+        if isinstance(other, LieGroup) or hasattr(other, "__rmatmul_rigidkit__"):
+            return NotImplemented
+        return self.apply(other)
+
+    def __rmatmul__(self, other):
+        if isinstance(other, Rotation2D):
+            return Transform2D(rotation=other) @ self
+        raise TypeError(
+            "array @ Transform2D is not defined; map points with T @ p or T.apply(p)"
+        )
+
+    def apply(self, points, *, out=None):
+        """Map points ``R p + t``, shape (..., 2) broadcasting with the batch shape."""
+        p = as_array(points, (2,), "points")
+        return _k.pose_apply(self._data, p, out=out)
+
+    def inv(self):
+        """Inverse motions ``(R^T, -R^T t)``."""
+        return Transform2D._wrap(_k.pose_inverse(self._data))
+
+    def approx_equal(self, other, *, atol=1e-8):
+        """Elementwise: rotation angle between them and translation distance <= ``atol``."""
+        angle, dist = _k.pose_distance(self._data, other._data)
+        return (angle <= atol) & (dist <= atol)
+
+    def __repr__(self):
+        if self.single:
+            rot = repr(self.rotation)
+            t = ", ".join(f"{float(v):.6g}" for v in _to_np(self.translation))
+            return f"Transform2D(rotation={rot}, translation=[{t}])"
+        return f"Transform2D(shape={self.shape}, dtype={self.dtype})"
