@@ -299,7 +299,7 @@ class Kernel(_Rebindable):
         if backend is None:
             if n == 1:
                 backend = "python"
-            elif numba_backend.available() and (n > NUMBA_MIN or dtype in self._warm):
+            elif (n > NUMBA_MIN or dtype in self._warm) and numba_backend.available():
                 backend = "numba"
             else:
                 return self._call_xp(np, params, arrays, batch)
