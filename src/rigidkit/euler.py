@@ -1,0 +1,373 @@
+"""Euler angles in all 24 sequences (functional layer: arrays in, arrays out).
+
+Conventions: a sequence is three letters of ``xyz``; UPPERCASE = intrinsic (about
+the body axes, each turn about the axes moved by the turns before), lowercase =
+extrinsic (about the fixed world axes), as in scipy. "Right-multiply body,
+left-multiply world":
+
+* intrinsic ``"XYZ"`` with angles ``(a, b, c)`` is ``Rx(a) @ Ry(b) @ Rz(c)``;
+* extrinsic ``"xyz"`` with angles ``(a, b, c)`` is ``Rz(c) @ Ry(b) @ Rx(a)``,
+
+so intrinsic ``"XYZ"`` equals extrinsic ``"zyx"`` with the angles reversed.
+Proper Euler sequences repeat the first axis last (``"ZXZ"``), Tait-Bryan
+sequences use three different axes (``"ZYX"``, yaw-pitch-roll). Rotations are
+active and act on column vectors, ``v_A = A_R_B @ v_B``; quaternions are Hamilton,
+scalar first ``(w, x, y, z)``. Angles are radians unless ``degrees=True``.
+
+>>> import numpy as np
+>>> q = quat_from_euler("ZYX", [90.0, 0.0, 0.0], degrees=True)
+>>> np.round(q, 12) + 0.0
+array([0.70710678, 0.        , 0.        , 0.70710678])
+>>> np.round(euler_from_quat("ZYX", q, degrees=True), 12) + 0.0
+array([90.,  0.,  0.])
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+import warnings
+from typing import NamedTuple
+
+import numpy as np
+
+from . import conversions as _conv
+from ._engine.namespace import namespace_of
+from ._validate import as_array, batch_index, check_finite, where_text
+from .errors import EulerSequenceError, GimbalLockWarning
+from .kernels import euler as _k
+
+__all__ = [
+    "EulerSequence",
+    "parse_sequence",
+    "quat_from_euler",
+    "euler_from_quat",
+    "matrix_from_euler",
+    "euler_from_matrix",
+    "gimbal_lock_threshold",
+]
+
+_ACCEPTED = (
+    "an Euler sequence is three letters of x, y, z, all UPPERCASE (intrinsic, body "
+    "axes: 'ZYX', 'XYZ', 'ZXZ', ...) or all lowercase (extrinsic, world axes: "
+    "'zyx', 'xyz', 'zxz', ...), with no axis repeated in consecutive places"
+)
+
+
+class EulerSequence(NamedTuple):
+    """A parsed Euler sequence and the static kernel parameters it stands for.
+
+    ``axes`` are the axis indices (0 = x, 1 = y, 2 = z) in the order written;
+    ``intrinsic`` is True for UPPERCASE; ``proper`` is True when the first axis is
+    repeated last. ``params`` are the parameters of the kernels in
+    :mod:`rigidkit.kernels.euler` (matrix-product order, parity, flags).
+    """
+
+    text: str
+    axes: tuple
+    intrinsic: bool
+    proper: bool
+    params: tuple
+
+
+_PARSED: dict = {}
+
+
+def parse_sequence(seq) -> EulerSequence:
+    """Parse an Euler sequence string such as ``"ZYX"`` (intrinsic) or ``"zxz"``.
+
+    Raises
+    ------
+    EulerSequenceError
+        For anything but three letters of ``xyz`` in one case with no axis
+        repeated consecutively ("XXY", "xYz", "abc", "XYZX", "", non-strings).
+
+    Examples
+    --------
+    >>> s = parse_sequence("ZXZ")
+    >>> s.axes, s.intrinsic, s.proper
+    ((2, 0, 2), True, True)
+    >>> parse_sequence("xYz")
+    Traceback (most recent call last):
+    ...
+    rigidkit.errors.EulerSequenceError: 'xYz' mixes upper and lower case; an Euler ...
+    """
+    try:
+        return _PARSED[seq]
+    except (KeyError, TypeError):
+        pass
+    parsed = _parse(seq)
+    _PARSED[seq] = parsed
+    return parsed
+
+
+def _parse(seq) -> EulerSequence:
+    if not isinstance(seq, str):
+        raise EulerSequenceError(
+            f"Euler sequence must be a string, got {type(seq).__name__}; {_ACCEPTED}"
+        )
+    if len(seq) != 3:
+        raise EulerSequenceError(f"{seq!r} has {len(seq)} letters, not 3; {_ACCEPTED}")
+    if seq.lower() != seq and seq.upper() != seq:
+        raise EulerSequenceError(f"{seq!r} mixes upper and lower case; {_ACCEPTED}")
+    low = seq.lower()
+    if any(c not in "xyz" for c in low):
+        raise EulerSequenceError(f"{seq!r} has letters other than x, y, z; {_ACCEPTED}")
+    if low[0] == low[1] or low[1] == low[2]:
+        raise EulerSequenceError(
+            f"{seq!r} repeats an axis in consecutive places (two turns about one "
+            f"axis are one turn); {_ACCEPTED}"
+        )
+    axes = tuple("xyz".index(c) for c in low)
+    intrinsic = seq.isupper()
+    # Matrix-product order: R_e1 R_e2 R_e3. Intrinsic "IJK" is R_I R_J R_K with the
+    # angles as given; extrinsic "ijk" is R_k R_j R_i, the angles reversed.
+    e1, e2, e3 = axes if intrinsic else axes[::-1]
+    # Levi-Civita symbol of (e1, e2, m), m the remaining axis: +1 for xy, yz, zx.
+    parity = 1 if (e2 - e1) % 3 == 1 else -1
+    proper = e1 == e3
+    params = (e1, e2, parity, int(proper), 0 if intrinsic else 1)
+    return EulerSequence(seq, axes, intrinsic, proper, params)
+
+
+def gimbal_lock_threshold(dtype) -> float:
+    """Distance (radians) of the middle angle from the lock below which we warn.
+
+    ``sqrt(eps)`` of the dtype: 1.5e-8 for float64, 3.5e-4 for float32. The first
+    and third angles have condition number about ``1 / distance`` with respect to
+    the rotation (only their sum or difference is well determined there), so a
+    rotation known to ``eps`` fixes them only to ``eps / distance``: below
+    ``sqrt(eps)`` at least half of their significant digits are noise. The
+    rebuilt rotation stays exact at any distance.
+
+    >>> gimbal_lock_threshold(np.float64), gimbal_lock_threshold(np.float32)
+    (1.4901161193847656e-08, 0.00034526698300124393)
+    """
+    try:
+        return _THRESHOLDS[dtype]
+    except (KeyError, TypeError):
+        pass
+    eps = 1.1920928955078125e-07 if "32" in str(dtype) else 2.220446049250313e-16
+    tol = math.sqrt(eps)
+    try:
+        _THRESHOLDS[dtype] = tol
+    except TypeError:  # unhashable dtype object
+        pass
+    return tol
+
+
+_THRESHOLDS: dict = {}
+
+
+def quat_from_euler(seq, angles, *, degrees=False):
+    """Unit quaternions of Euler angles, for any of the 24 sequences.
+
+    Conventions: UPPERCASE ``seq`` = intrinsic (body axes), lowercase = extrinsic
+    (world axes); intrinsic ``"XYZ"`` is ``Rx(a) @ Ry(b) @ Rz(c)``, extrinsic
+    ``"xyz"`` is ``Rz(c) @ Ry(b) @ Rx(a)``. Quaternions are Hamilton, scalar first.
+
+    The quaternion is the product of the three axis quaternions
+    ``(cos(t/2), sin(t/2) e_axis)``, in closed form (no matrices).
+
+    Parameters
+    ----------
+    seq : str
+        Three letters of ``xyz`` (see :func:`parse_sequence`).
+    angles : array_like, shape (..., 3)
+        Angles in the order of ``seq``; radians, or degrees with ``degrees=True``.
+    degrees : bool
+
+    Returns
+    -------
+    quat : array, shape (..., 4)
+        ``(w, x, y, z)``, of the namespace and floating dtype of ``angles``.
+
+    Raises
+    ------
+    EulerSequenceError, ShapeError, NonFiniteError
+
+    See Also
+    --------
+    euler_from_quat : the inverse.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> q = quat_from_euler("XYZ", [np.pi / 2, 0.0, 0.0])
+    >>> np.round(q, 12) + 0.0
+    array([0.70710678, 0.70710678, 0.        , 0.        ])
+    """
+    s = parse_sequence(seq)
+    a = as_array(angles, (3,), f"Euler angles for {seq!r}")
+    check_finite(a, (3,), f"Euler angles for {seq!r}")
+    scale = math.pi / 180.0 if degrees else 1.0
+    return _k.quat_from_euler(*s.params, scale, a)
+
+
+def euler_from_quat(seq, quat, *, degrees=False):
+    """Euler angles of unit quaternions, for any of the 24 sequences.
+
+    Conventions: UPPERCASE ``seq`` = intrinsic (body axes), lowercase = extrinsic
+    (world axes); quaternions are Hamilton, scalar first ``(w, x, y, z)``.
+
+    Every angle is an ``atan2`` of quantities free of cancellation (Bernardes &
+    Viollet 2022), so the angles are accurate to a few ulp and rebuild the
+    rotation to about 1e-16 rad everywhere, at and near gimbal lock too.
+
+    Parameters
+    ----------
+    seq : str
+        Three letters of ``xyz`` (see :func:`parse_sequence`).
+    quat : array_like, shape (..., 4)
+        Unit quaternions (as :class:`~rigidkit.Rotation` stores them). They are not
+        validated: normalise raw input with :func:`rigidkit.conversions.quat_normalize`
+        (a zero quaternion would give zero angles).
+    degrees : bool
+
+    Returns
+    -------
+    angles : array, shape (..., 3)
+        In the order of ``seq``. First and third angle in (-pi, pi]; the middle in
+        [0, pi] for proper sequences, [-pi/2, pi/2] for Tait-Bryan ones (degrees:
+        (-180, 180], [0, 180], [-90, 90]).
+
+    Warns
+    -----
+    GimbalLockWarning
+        Once per call, when any middle angle is within
+        :func:`gimbal_lock_threshold` (1.5e-8 rad for float64) of the lock (0 or pi
+        for proper sequences, +-pi/2 for Tait-Bryan ones). There only the sum or
+        difference of the first and third angle is well determined; the angles
+        returned still rebuild the rotation, and at exact lock the third is 0.
+
+    See Also
+    --------
+    quat_from_euler : the inverse.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> q = quat_from_euler("zxz", [0.1, 0.2, 0.3])
+    >>> np.round(euler_from_quat("zxz", q), 12) + 0.0
+    array([0.1, 0.2, 0.3])
+
+    At gimbal lock (here a quarter turn about y, pitch +90 degrees in ``"ZYX"``):
+
+    >>> import warnings
+    >>> q_lock = np.array([np.sqrt(0.5), 0.0, np.sqrt(0.5), 0.0])
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     angles = euler_from_quat("ZYX", q_lock, degrees=True)
+    >>> caught[0].category.__name__, angles + 0.0
+    ('GimbalLockWarning', array([ 0., 90.,  0.]))
+    """
+    s = parse_sequence(seq)
+    scale = 180.0 / math.pi if degrees else 1.0
+    angles = _k.euler_from_quat(*s.params, scale, quat)
+    _warn_if_locked(s, angles, scale)
+    return angles
+
+
+def matrix_from_euler(seq, angles, *, degrees=False):
+    """Rotation matrices of Euler angles, shape (..., 3, 3).
+
+    Conventions: UPPERCASE ``seq`` = intrinsic, lowercase = extrinsic; intrinsic
+    ``"XYZ"`` is ``Rx(a) @ Ry(b) @ Rz(c)``. Active matrices on column vectors.
+
+    See Also
+    --------
+    euler_from_matrix : the inverse.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> np.round(matrix_from_euler("zyx", [90.0, 0.0, 0.0], degrees=True), 12) + 0.0
+    array([[ 0., -1.,  0.],
+           [ 1.,  0.,  0.],
+           [ 0.,  0.,  1.]])
+    """
+    return _conv.matrix_from_quat(quat_from_euler(seq, angles, degrees=degrees))
+
+
+def euler_from_matrix(seq, matrix, *, degrees=False, atol=None):
+    """Euler angles of rotation matrices (validated, see ``quat_from_matrix``).
+
+    Conventions: UPPERCASE ``seq`` = intrinsic, lowercase = extrinsic. Ranges and
+    the gimbal-lock warning as in :func:`euler_from_quat`.
+
+    See Also
+    --------
+    matrix_from_euler : the inverse.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> Rz = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    >>> np.round(euler_from_matrix("XYZ", Rz, degrees=True), 12) + 0.0
+    array([ 0.,  0., 90.])
+    """
+    q = _conv.quat_from_matrix(matrix, atol=atol)
+    s = parse_sequence(seq)
+    scale = 180.0 / math.pi if degrees else 1.0
+    angles = _k.euler_from_quat(*s.params, scale, q)
+    _warn_if_locked(s, angles, scale)
+    return angles
+
+
+def _warn_if_locked(s: EulerSequence, angles, scale: float) -> None:
+    """Emit one :class:`GimbalLockWarning` if any middle angle is near the lock."""
+    dtype = getattr(angles, "dtype", np.float64)
+    tol = gimbal_lock_threshold(dtype) * scale
+    half = 0.5 * math.pi * scale
+    # Lock at 0 and pi (proper) or -pi/2 and pi/2 (Tait-Bryan): |mid - center| = half.
+    center = half if s.proper else 0.0
+    if isinstance(angles, np.ndarray) and angles.ndim == 1:  # one element: no reductions
+        if abs(float(angles[1]) - center) <= half - tol:
+            return
+    mid = angles[..., 1]
+    if isinstance(mid, np.ndarray):
+        if mid.size == 0 or (
+            # Two reductions without temporaries: the common, lock-free case.
+            mid.min() >= center - half + tol and mid.max() <= center + half - tol
+        ):
+            return
+        near = np.abs(mid - center) > half - tol  # False for NaN (never a lock)
+        if not near.any():
+            return
+    else:
+        xp = namespace_of(mid)
+        near = xp.abs(mid - center) > half - tol
+        if not bool(xp.any(near)):
+            return
+    near = _host(near)
+    lock = "0 or pi" if s.proper else "+-pi/2"
+    warnings.warn(
+        f"gimbal lock in {s.text!r}: {int(near.sum())} of {max(near.size, 1)} middle "
+        f"angles are within {tol / scale:.2g} rad of {lock} (first "
+        f"{where_text(batch_index(near))}); there only the sum or difference of the "
+        f"first and third angle is well determined. The angles returned rebuild the "
+        f"rotation; at exact lock the third angle is 0.",
+        GimbalLockWarning,
+        stacklevel=_user_stacklevel(),
+    )
+
+
+def _host(a):
+    return a.detach().cpu().numpy() if hasattr(a, "detach") else np.asarray(a)
+
+
+_PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))
+
+
+def _user_stacklevel() -> int:
+    """``stacklevel`` for ``warnings.warn`` that points at the first caller outside
+    rigidkit (so the warning names the user's line, whichever API they called)."""
+    frame = sys._getframe(1)
+    level = 1
+    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(
+        _PACKAGE_DIR + os.sep
+    ):
+        frame = frame.f_back
+        level += 1
+    return level
