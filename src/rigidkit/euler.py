@@ -14,12 +14,29 @@ sequences use three different axes (``"ZYX"``, yaw-pitch-roll). Rotations are
 active and act on column vectors, ``v_A = A_R_B @ v_B``; quaternions are Hamilton,
 scalar first ``(w, x, y, z)``. Angles are radians unless ``degrees=True``.
 
+Gimbal lock: when the middle angle is at its lock (0 or pi for proper sequences,
++-pi/2 for Tait-Bryan ones) only the sum or difference of the first and third
+angle is determined. We then return the third angle 0 and the whole turn in the
+first, also when the quaternion is only numerically at the lock (a float
+quaternion of angles ``(a, pi/2, b)`` sits a rounding error away from it), as long
+as that moves the rotation by at most :func:`lock_tolerance` (2 eps, 4.4e-16 rad
+for float64). Otherwise the angles are the exact split, however close to the lock.
+
 >>> import numpy as np
 >>> q = quat_from_euler("ZYX", [90.0, 0.0, 0.0], degrees=True)
 >>> np.round(q, 12) + 0.0
 array([0.70710678, 0.        , 0.        , 0.70710678])
 >>> np.round(euler_from_quat("ZYX", q, degrees=True), 12) + 0.0
 array([90.,  0.,  0.])
+
+At the lock, yaw 30, pitch 90, roll 10 is the same rotation as yaw 20, pitch 90:
+
+>>> import warnings
+>>> q = quat_from_euler("ZYX", [30.0, 90.0, 10.0], degrees=True)
+>>> with warnings.catch_warnings():
+...     warnings.simplefilter("ignore")
+...     euler_from_quat("ZYX", q, degrees=True)
+array([20., 90.,  0.])
 """
 
 from __future__ import annotations
@@ -46,6 +63,7 @@ __all__ = [
     "matrix_from_euler",
     "euler_from_matrix",
     "gimbal_lock_threshold",
+    "lock_tolerance",
 ]
 
 _ACCEPTED = (
@@ -148,8 +166,7 @@ def gimbal_lock_threshold(dtype) -> float:
         return _THRESHOLDS[dtype]
     except (KeyError, TypeError):
         pass
-    eps = 1.1920928955078125e-07 if "32" in str(dtype) else 2.220446049250313e-16
-    tol = math.sqrt(eps)
+    tol = math.sqrt(_eps(dtype))
     try:
         _THRESHOLDS[dtype] = tol
     except TypeError:  # unhashable dtype object
@@ -158,6 +175,35 @@ def gimbal_lock_threshold(dtype) -> float:
 
 
 _THRESHOLDS: dict = {}
+
+
+def _eps(dtype) -> float:
+    """Machine epsilon of a float dtype of any namespace (float32, else float64)."""
+    return 1.1920928955078125e-07 if "float32" in str(dtype) else 2.220446049250313e-16
+
+
+def _dtype(a):
+    return getattr(a, "dtype", None)  # None (lists, floats): computed in float64
+
+
+def lock_tolerance(dtype) -> float:
+    """Radians the rotation may move to return the lock convention: ``2 eps``.
+
+    4.4e-16 for float64, 2.4e-7 for float32 (the input quaternion's dtype: a
+    float32 quaternion carries float32 rounding, whatever precision the kernel
+    computes in). Changing every component of a quaternion by one ulp (at most
+    ``eps |q_i|``) moves it by at most ``eps |q|``, i.e. the rotation by at most
+    ``2 eps`` rad. So the angles returned at a numerical lock are the exact
+    angles of a rotation no farther from the given one than one-ulp changes of
+    its quaternion reach, and a quaternion computed from lock angles (a rounding
+    residue of a few ulp) is cleaned: for ``from_euler`` at lock we measured a
+    cost of at most 4.2e-16 over a million random float64 cases, all 24
+    sequences, radians and degrees.
+
+    >>> lock_tolerance(np.float64), lock_tolerance(np.float32)
+    (4.440892098500626e-16, 2.384185791015625e-07)
+    """
+    return 2.0 * _eps(dtype)
 
 
 def quat_from_euler(seq, angles, *, degrees=False):
@@ -215,6 +261,17 @@ def euler_from_quat(seq, quat, *, degrees=False):
     Viollet 2022), so the angles are accurate to a few ulp and rebuild the
     rotation to about 1e-16 rad everywhere, at and near gimbal lock too.
 
+    At gimbal lock the third angle is 0 and the whole turn about the first axis
+    is in the first angle (intrinsic ``"ZYX"`` at pitch +90 degrees: yaw - roll;
+    extrinsic ``"zyx"``: yaw + roll; at -90 the signs flip). This holds not only
+    at exact lock but whenever returning it moves the rotation by at most
+    :func:`lock_tolerance` of the dtype of ``quat`` (2 eps: 4.4e-16 rad for
+    float64, 2.4e-7 for float32), e.g. for quaternions computed from angles
+    ``(a, 90, b)`` degrees; the middle angle is then that of the nearest such
+    rotation. Farther from the lock (1e-12 rad, say) the angles are the exact
+    split of ``quat``, accurate, but only their sum or difference is well
+    conditioned.
+
     Parameters
     ----------
     seq : str
@@ -239,7 +296,8 @@ def euler_from_quat(seq, quat, *, degrees=False):
         :func:`gimbal_lock_threshold` (1.5e-8 rad for float64) of the lock (0 or pi
         for proper sequences, +-pi/2 for Tait-Bryan ones). There only the sum or
         difference of the first and third angle is well determined; the angles
-        returned still rebuild the rotation, and at exact lock the third is 0.
+        returned still rebuild the rotation, and at lock (within
+        :func:`lock_tolerance`) the third is 0.
 
     See Also
     --------
@@ -264,7 +322,7 @@ def euler_from_quat(seq, quat, *, degrees=False):
     """
     s = parse_sequence(seq)
     scale = 180.0 / math.pi if degrees else 1.0
-    angles = _k.euler_from_quat(*s.params, scale, quat)
+    angles = _k.euler_from_quat(*s.params, scale, lock_tolerance(_dtype(quat)), quat)
     _warn_if_locked(s, angles, scale)
     return angles
 
@@ -310,7 +368,7 @@ def euler_from_matrix(seq, matrix, *, degrees=False, atol=None):
     q = _conv.quat_from_matrix(matrix, atol=atol)
     s = parse_sequence(seq)
     scale = 180.0 / math.pi if degrees else 1.0
-    angles = _k.euler_from_quat(*s.params, scale, q)
+    angles = _k.euler_from_quat(*s.params, scale, lock_tolerance(_dtype(q)), q)
     _warn_if_locked(s, angles, scale)
     return angles
 
@@ -347,7 +405,7 @@ def _warn_if_locked(s: EulerSequence, angles, scale: float) -> None:
         f"angles are within {tol / scale:.2g} rad of {lock} (first "
         f"{where_text(batch_index(near))}); there only the sum or difference of the "
         f"first and third angle is well determined. The angles returned rebuild the "
-        f"rotation; at exact lock the third angle is 0.",
+        f"rotation; at lock (within {lock_tolerance(dtype):.2g} rad) the third angle is 0.",
         GimbalLockWarning,
         stacklevel=_user_stacklevel(),
     )

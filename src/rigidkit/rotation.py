@@ -200,7 +200,9 @@ class Rotation(LieGroup):
         First and third angles in (-pi, pi]; the second in [0, pi] for proper
         sequences (``ZXZ``) and [-pi/2, pi/2] for Tait-Bryan ones (``ZYX``). At gimbal
         lock a :class:`~rigidkit.GimbalLockWarning` is emitted and the third angle
-        is 0; the angles always rebuild the rotation.
+        is 0, also at a lock missed by rounding only (angles like ``(30, 90, 10)``
+        degrees: see :func:`rigidkit.euler.euler_from_quat`); the angles always
+        rebuild the rotation.
         """
         from . import euler
 

@@ -20,6 +20,10 @@ Parameters of both kernels, in matrix-product order ``R = R_e1(t1) R_e2(t2) R_e3
 ``scale``
     Radians per input unit (``from_euler``) or output units per radian
     (``euler_from_quat``): 1, or the degree factor.
+``tol`` (``euler_from_quat`` only)
+    Radians: at gimbal lock, how far the rotation may move to return the lock
+    convention (angle written third 0) instead of the exact split of a rounding
+    residue. 2 eps of the input dtype (see :func:`rigidkit.euler.euler_from_quat`).
 
 The permuted quaternion ``p = (w, q[e1], q[e2], parity * q[m])`` reduces every
 sequence to the cyclic one: for proper sequences the parity sign is absorbed by
@@ -92,9 +96,9 @@ def quat_from_euler(e1, e2, parity, proper, reverse, scale, a0, a1, a2):
 @kernel(
     inputs=[(4,)],
     outputs=[(3,)],
-    params=("e1", "e2", "parity", "proper", "reverse", "scale"),
+    params=("e1", "e2", "parity", "proper", "reverse", "scale", "tol"),
 )
-def euler_from_quat(e1, e2, parity, proper, reverse, scale, w, x, y, z):
+def euler_from_quat(e1, e2, parity, proper, reverse, scale, tol, w, x, y, z):
     """Euler angles of a quaternion, accurate everywhere, gimbal lock included.
 
     After Bernardes & Viollet (2022), "Quaternion to Euler angles conversion: A
@@ -102,31 +106,54 @@ def euler_from_quat(e1, e2, parity, proper, reverse, scale, w, x, y, z):
     ``v = (q[e1], q[e2], parity * q[m])`` the rotation is split into two complex
     numbers ``z1 = |z1| e^{iS}``, ``z2 = |z2| e^{iD}``:
 
-    * proper: ``z1 = w + i v1``, ``z2 = v2 + i v3``; ``t2 = 2 atan2(|z2|, |z1|)``,
+    * proper: ``z1 = w + i v1``, ``z2 = v2 + i v3``; ``t2 = 2 arg(|z1| + i |z2|)``,
       ``t1 = S + D = arg(z1 z2)``, ``t3 = S - D = arg(z1 conj(z2))``;
     * Tait-Bryan: ``q q_e2(pi/2)`` is the proper sequence ``e1 e2 e1`` with angles
       ``(t1, t2 + pi/2, -t3)``, whose ``z1 = (w - v2) + i (v1 - v3)`` and
-      ``z2 = (w + v2) + i (v1 + v3)`` (up to a common factor); then
-      ``t2 = atan2(2 (w v2 + v1 v3), |z1| |z2|)`` (the sine without cancellation,
-      so small ``t2`` keep their relative accuracy), ``t1 = arg(z1 z2)`` and
-      ``t3 = parity * arg(z2 conj(z1))``.
+      ``z2 = (w + v2) + i (v1 + v3)`` (up to the common factor ``1/sqrt(2)``);
+      then ``t2 = arg(|z1| |z2| + 2 i (w v2 + v1 v3))`` (the sine without
+      cancellation, so small ``t2`` keep their relative accuracy),
+      ``t1 = arg(z1 z2)`` and ``t3 = parity * arg(z2 conj(z1))``.
 
-    Every angle is an ``atan2`` (no ``acos``/``asin`` of a matrix entry) of
-    quantities computed to a few ulp *relative*: the components of ``z1`` and
-    ``z2`` are single components of ``q`` or, for Tait-Bryan, sums and differences
-    that are exact (Sterbenz) exactly where they are small, i.e. near the lock.
-    So all three angles are accurate to a few ulp for the quaternion given, at
-    any distance from the lock. Near the lock the first and third angle are
-    ill-conditioned with respect to the rotation (``arg`` of the tiny ``z1`` or
-    ``z2`` enters them with opposite signs), but the rebuilt rotation is exact.
-    At exact lock (``z1`` or ``z2`` zero) the split is undetermined: we then put
-    the whole rotation into the angle written first and make the one written
-    third 0 (``t3`` for intrinsic, ``t1`` for extrinsic sequences). There is no
-    other threshold. First and third angles are in (-pi, pi];
-    the middle in [0, pi] (proper) or [-pi/2, pi/2] (Tait-Bryan).
+    Every angle is an ``atan2`` (no ``acos``/``asin`` of a matrix entry; three
+    calls, one per angle, most of the time of a numba loop) of quantities
+    computed to a few ulp *relative*: the components
+    of ``z1`` and ``z2`` are single components of ``q`` or, for Tait-Bryan, sums
+    and differences that are exact (Sterbenz) exactly where they are small, i.e.
+    near the lock. So all three angles are accurate to a few ulp for the
+    quaternion given, at any distance from the lock.
 
-    The formulas are homogeneous of degree 0 in ``q``: ``q`` need not be unit (but
-    should be of moderate scale, since it is squared).
+    Gimbal lock. Near the lock one of ``z1``, ``z2`` (``z_s``, the other ``z_b``)
+    is small, and the first and third angle are ill-conditioned with respect to
+    the rotation (``arg z_s`` enters them with opposite signs). A float
+    quaternion meant to be at the lock (from angles like ``(a, pi/2, b)``) has a
+    ``z_s`` of rounding size whose argument is noise, and so would be its first
+    and third angle. The lock convention puts the whole rotation into the angle
+    written first and makes the one written third 0 (``t3`` for intrinsic, ``t1``
+    for extrinsic sequences; then ``z_s`` is a multiple of ``z_b`` or of its
+    conjugate). We return it whenever the nearest such decomposition is within
+    ``tol`` (radians) of ``q``. That nearest one replaces ``z_s`` by its
+    projection on the ray it must lie on, which makes the angle ``t0`` between
+    them (``t0`` = the angle written third). With ``W = X + iY`` the product whose
+    argument is ``t0`` (``|W| = |z1| |z2|``) the projection is ``|z_s| cos t0 =
+    X / |z_b|`` (0 if ``X < 0``), the distance ``|z_s| |sin t0| = |Y| / |z_b|``
+    (``|z_s|`` if ``X < 0``), and the rotation moves by ``2 asin(distance /
+    |q|)``, ``|q|^2 = (|z1|^2 + |z2|^2) / (2 if Tait-Bryan else 1)`` (the common
+    factor cancels). So, squared and multiplied out (no division, and no
+    underflow for a tiny ``z_s``, which always passes):
+    ``Y^2 + min(X, 0)^2 <= (tol^2 / 4) (|z1|^2 + |z2|^2) |z_b|^2``. Then the
+    angle written first is ``+-arg(z_b^2)`` and the middle angle is that of the
+    projection. This covers the exact lock (``z_s = 0``) and a zero ``q`` (zero
+    angles). The caller's ``tol`` is 2 eps of the input dtype (see
+    :func:`rigidkit.euler.lock_tolerance`): a middle angle ``d`` from the lock has
+    ``|z_s| / |q| = sin(d / 2)`` (Tait-Bryan: in the proper form), so the rotation
+    moves by ``d |sin t0|`` or less; at ``d = 1e-12`` the exact split is kept
+    unless ``|sin t0| < 4.4e-4`` (where it is itself uncertain by that much).
+
+    First and third angles are in (-pi, pi]; the middle in [0, pi] (proper) or
+    [-pi/2, pi/2] (Tait-Bryan). The formulas are homogeneous of degree 0 in
+    ``q``: ``q`` need not be unit, but should be of moderate scale (1e-70 to
+    1e70), since the lock test multiplies four squares.
     """
     m = 3 - e1 - e2
     # Gather by static axis index (a tuple index: numba, NumPy, torch, SymPy alike).
@@ -134,46 +161,59 @@ def euler_from_quat(e1, e2, parity, proper, reverse, scale, w, x, y, z):
     v2 = (x, y, z)[e2]
     v3 = parity * (x, y, z)[m]
     is_proper = proper == 1
+    rev = reverse == 1
     a = where(is_proper, w, w - v2)
     b = where(is_proper, v1, v1 - v3)
     c = where(is_proper, v2, w + v2)
     d = where(is_proper, v3, v1 + v3)
-    # Scale z1 and z2 by their largest component: the products below then keep
-    # their relative accuracy (and t1, t3 their shared error) however small a number
-    # is, subnormal included, and |z| = m |z / m| cannot underflow.
-    m1 = maximum(abs(a), abs(b))
-    m2 = maximum(abs(c), abs(d))
-    z1_zero = m1 <= 0.0
-    z2_zero = m2 <= 0.0
-    s1 = where(z1_zero, 1.0, m1)
-    s2 = where(z2_zero, 1.0, m2)
-    a = a / s1
-    b = b / s1
-    c = c / s2
-    d = d / s2
-    n1 = m1 * sqrt(a * a + b * b)
-    n2 = m2 * sqrt(c * c + d * d)
-    # Middle angle: proper 2 atan2(|z2|, |z1|); Tait-Bryan atan2(sin, cos). One atan2
-    # call with selected arguments (a numba loop evaluates both sides of a where).
-    mid = where(is_proper, 2.0, 1.0) * atan2(
-        where(is_proper, n2, 2.0 * (w * v2 + v1 * v3)),
-        where(is_proper, n1, n1 * n2),
-    )
-    # Exact lock: one number is zero, its argument undetermined. Replacing it by the
-    # other number gives t3 = 0 (product order), by the other's conjugate t1 = 0;
-    # either way the angle written third is 0.
-    flip = where(reverse == 1, -1.0, 1.0)
-    a1 = where(z1_zero, c, a)
-    b1 = where(z1_zero, flip * d, b)
-    c1 = where(z2_zero, a, c)
-    d1 = where(z2_zero, flip * b, d)
-    first = angle_of(a1 * c1 - b1 * d1, a1 * d1 + b1 * c1)
-    # arg(z1 conj(z2)) for proper; parity * arg(z2 conj(z1)) for Tait-Bryan.
+    aa = a * a
+    bb = b * b
+    cc = c * c
+    dd = d * d
+    n1sq = aa + bb
+    n2sq = cc + dd
+    # z1 z2 (argument t1) and z1 conj(z2) with its sign made that of t3: proper
+    # arg(z1 conj(z2)), Tait-Bryan parity * arg(z2 conj(z1)).
+    ac = a * c
+    bd = b * d
+    ad = a * d
+    bc = b * c
     sign3 = where(is_proper, 1, -parity)
-    third = angle_of(a1 * c1 + b1 * d1, sign3 * (b1 * c1 - a1 * d1))
-    rev = reverse == 1
-    return (
-        where(rev, third, first) * scale,
-        mid * scale,
-        where(rev, first, third) * scale,
+    p_x = ac - bd
+    p_y = ad + bc
+    m_x = ac + bd
+    m_y = sign3 * (bc - ad)
+    # The products whose arguments are the angles written first (F) and third (T).
+    f_x = where(rev, m_x, p_x)
+    f_y = where(rev, m_y, p_y)
+    t_x = where(rev, p_x, m_x)
+    t_y = where(rev, p_y, m_y)
+    # Lock test (docstring): the rotation moves by at most tol when the angle
+    # written third is set to 0 and z_s projected.
+    small1 = n1sq < n2sq
+    outside = minimum(t_x, 0.0)
+    lock = t_y * t_y + outside * outside <= (0.25 * tol * tol) * (n1sq + n2sq) * where(
+        small1, n2sq, n1sq
     )
+    # At lock the angle written first is arg(z_b^2) (intrinsic), or for extrinsic
+    # sequences arg(z1^2) (z2 small) or arg(conj(z2)^2) (z1 small), times sign3.
+    g = where(rev, where(small1, -sign3, sign3), 1)
+    sq_x = where(small1, cc - dd, aa - bb)
+    sq_y = g * 2.0 * where(small1, c * d, a * b)
+    first = angle_of(where(lock, sq_x, f_x), where(lock, sq_y, f_y))
+    third = where(lock, 0.0, angle_of(t_x, t_y))
+    # Middle angle: the argument of a vector parallel to (|z1|, |z2|) (proper,
+    # doubled), here times |z1|, or of (|z1| |z2|, 2 (w v2 + v1 v3)) (Tait-Bryan).
+    # At lock |z_s| is replaced by the projection X / |z_b|: (|z1|, |z2|) |z_b|
+    # becomes (|z1|^2, X) or (X, |z2|^2), and |z1| |z2| becomes X. One sqrt.
+    proj = where(t_x > 0.0, t_x, 0.0)  # +0.0 also for t_x = -0.0
+    n12 = sqrt(n1sq * n2sq)
+    mid_c = where(is_proper, where(lock & small1, proj, n1sq), where(lock, proj, n12))
+    mid_s = where(
+        is_proper,
+        where(lock, where(small1, n2sq, proj), n12),
+        2.0 * (w * v2 + v1 * v3),
+    )
+    # mid_c >= +0: atan2 in [-pi/2, pi/2], no fold needed.
+    mid = where(is_proper, 2.0, 1.0) * atan2(mid_s, mid_c)
+    return (first * scale, mid * scale, third * scale)
