@@ -39,7 +39,7 @@ from .primitives import PRIMITIVES, math_bindings, sympy_bindings, xp_bindings
 #: Below this many elements a NumPy call never waits for a JIT compile.
 NUMBA_MIN = int(os.environ.get("RIGIDKIT_NUMBA_MIN", "1000"))
 
-_HELPERS: dict[str, "Helper"] = {}
+_HELPERS: dict[str, Helper] = {}
 _F64 = np.dtype(np.float64)
 _F32 = np.dtype(np.float32)
 
@@ -72,7 +72,7 @@ class _Rebindable:
                     f"nor a registered helper"
                 )
 
-    def dependencies(self) -> list["Helper"]:
+    def dependencies(self) -> list[Helper]:
         """Helpers called by this function, transitively, callees first."""
         order: list[Helper] = []
         seen: set[str] = set()
@@ -376,7 +376,9 @@ class Kernel(_Rebindable):
             if not trail:
                 comps.append(a)
                 continue
-            flat = xp.reshape(a, tuple(a.shape[: a.ndim - len(trail)]) + (math.prod(trail),))
+            flat = xp.reshape(
+                a, tuple(a.shape[: a.ndim - len(trail)]) + (math.prod(trail),)
+            )
             comps += [flat[..., c] for c in range(math.prod(trail))]
         key = (getattr(xp, "__name__", id(xp)), str(dtype), str(device))
         fn = self._xp_cache.get(key)

@@ -60,12 +60,18 @@ def _torch_namespace():
             zeros=lambda shape, dtype=None, device=None: torch.zeros(
                 tuple(shape), dtype=dtype, device=device
             ),
-            all=lambda x, axis=None: torch.all(x) if axis is None else torch.all(x, dim=axis),
-            any=lambda x, axis=None: torch.any(x) if axis is None else torch.any(x, dim=axis),
-            sum=lambda x, axis=None: torch.sum(x) if axis is None else torch.sum(x, dim=axis),
-            isdtype=lambda dtype, kind: dtype.is_floating_point
-            if kind == "real floating"
-            else False,
+            all=lambda x, axis=None: (
+                torch.all(x) if axis is None else torch.all(x, dim=axis)
+            ),
+            any=lambda x, axis=None: (
+                torch.any(x) if axis is None else torch.any(x, dim=axis)
+            ),
+            sum=lambda x, axis=None: (
+                torch.sum(x) if axis is None else torch.sum(x, dim=axis)
+            ),
+            isdtype=lambda dtype, kind: (
+                dtype.is_floating_point if kind == "real floating" else False
+            ),
             nonzero=torch.nonzero,
         )
         _TORCH_NS = ns

@@ -87,7 +87,8 @@ def _loop_source(kernel) -> str:
     body.append(f"        r = {kernel.name}({', '.join(call)})")
     for n, (k, c) in enumerate(outs):
         body.append(f"        o{k}[i, {c}] = r[{n}]")
-    head = f"@numba.njit(cache=CACHE, nogil=True, error_model='numpy')\ndef loop({', '.join(args)}):\n"
+    head = "@numba.njit(cache=CACHE, nogil=True, error_model='numpy')\n"
+    head += f"def loop({', '.join(args)}):\n"
     return head + "    for i in range(start, stop):\n" + "\n".join(body) + "\n"
 
 
