@@ -13,6 +13,10 @@ __all__ = [
     "ZeroNormError",
     "ShapeError",
     "EulerSequenceError",
+    "NotASimilarityError",
+    "NotAffineError",
+    "SingularMatrixError",
+    "PointAtInfinityError",
     "GimbalLockWarning",
 ]
 
@@ -39,6 +43,22 @@ class ShapeError(RigidkitError):
 
 class EulerSequenceError(RigidkitError):
     """An Euler sequence string is not one of the 24 accepted forms."""
+
+
+class NotASimilarityError(RigidkitError):
+    """A scale is not positive, or a matrix is not ``[[s R, t], [0, 1]]`` with ``s > 0``."""
+
+
+class NotAffineError(RigidkitError):
+    """A homogeneous matrix's bottom row is not ``[0, 0, 0, 1]``."""
+
+
+class SingularMatrixError(RigidkitError):
+    """A matrix that must be invertible is singular (to working precision)."""
+
+
+class PointAtInfinityError(RigidkitError):
+    """A projective transform maps a point to infinity (homogeneous ``w = 0``)."""
 
 
 class GimbalLockWarning(UserWarning):

@@ -223,8 +223,8 @@ class Rotation(LieGroup):
         """``R1 @ R2`` composes (``R2`` first); ``R @ v`` rotates vectors (..., 3)."""
         if isinstance(other, Rotation):
             return Rotation._wrap(_conv.quat_multiply(self._quat, other._quat))
-        if isinstance(other, LieGroup):
-            return NotImplemented  # e.g. Rotation @ Transform: the other side decides
+        if isinstance(other, LieGroup) or hasattr(other, "__rmatmul_rigidkit__"):
+            return NotImplemented  # e.g. Rotation @ Affine: the more general kind decides
         return self.apply(other)
 
     def __rmatmul__(self, other):

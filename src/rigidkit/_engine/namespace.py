@@ -73,6 +73,11 @@ def _torch_namespace():
                 dtype.is_floating_point if kind == "real floating" else False
             ),
             nonzero=torch.nonzero,
+            ones_like=torch.ones_like,
+            zeros_like=torch.zeros_like,
+            linalg=torch.linalg,
+            max=lambda x, axis=None: torch.amax(x) if axis is None else torch.amax(x, dim=axis),
+            matmul=torch.matmul,
         )
         _TORCH_NS = ns
     return _TORCH_NS

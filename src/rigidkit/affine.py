@@ -1,0 +1,265 @@
+"""``Affine``: invertible affine transforms of 3D space, ``p -> A p + t``.
+
+The homogeneous matrix is ``[[A, t], [0, 1]]`` with ``A`` any invertible 3x3 matrix
+(rotations, scalings, shears, reflections). It sits between
+:class:`~rigidkit.Similarity` and :class:`~rigidkit.Projective` on the ladder of
+kinds (see :mod:`rigidkit.projective`): composing with a lower kind gives an
+``Affine``, with a ``Projective`` a ``Projective``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._engine.namespace import device_of, namespace_of
+from ._validate import _to_numpy, as_array, batch_index, check_finite, where_text
+from .conversions import default_atol
+from .errors import NotAffineError
+from .kernels import homogeneous as _k
+from .projective import (
+    Projective,
+    _as_float,
+    _include_check,
+    _LadderMember,
+    check_invertible,
+    homogeneous_matrix,
+    singular_rtol,
+)
+
+__all__ = ["Affine", "NotAffineError"]
+
+
+class Affine(_LadderMember):
+    """A batch of invertible affine transforms ``p -> A p + t``.
+
+    Stored as one array of shape (..., 3, 4), ``[A | t]``. ``X1 @ X2`` applies ``X2``
+    first: ``[A1 A2 | A1 t2 + t1]``; ``X @ p`` maps points (..., 3).
+
+    Parameters
+    ----------
+    matrix : array_like, shape (..., 3, 3), optional
+        The linear part ``A`` (identity when omitted); finite and invertible: a
+        Hadamard ratio ``|det A| / prod |row_i|`` <= ``rtol`` raises
+        :class:`~rigidkit.SingularMatrixError` naming the batch index.
+    translation : array_like, shape (..., 3), optional
+        ``t`` (zero when omitted). Batch shapes broadcast.
+    rtol : float, optional
+        Default 1e-12 (float64) or 1e-5 (float32), see
+        :func:`rigidkit.projective.singular_rtol`.
+
+    Examples
+    --------
+    >>> X = Affine(matrix=[[2.0, 1.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+    ...            translation=[0.0, 0.0, 5.0])
+    >>> X @ np.array([1.0, 1.0, 1.0])
+    array([3., 1., 6.])
+    >>> X.inv() @ (X @ np.array([1.0, 1.0, 1.0]))
+    array([1., 1., 1.])
+    """
+
+    __slots__ = ("_data",)
+
+    def __init__(self, matrix=None, translation=None, *, rtol=None):
+        A = (
+            None
+            if matrix is None
+            else _as_float(as_array(matrix, (3, 3), "affine matrix A"))
+        )
+        t = (
+            None
+            if translation is None
+            else _as_float(as_array(translation, (3,), "translation"))
+        )
+        if A is None and t is None:
+            A = np.eye(3)
+        if A is not None:
+            check_finite(A, (3, 3), "affine matrix A")
+        if t is not None:
+            check_finite(t, (3,), "translation")
+        ref = A if A is not None else t
+        xp = namespace_of(ref)
+        dt = ref.dtype if A is None or t is None else _result_dtype(xp, A, t)
+        dev = device_of(ref)
+        if A is None:
+            A = xp.asarray(np.eye(3), dtype=dt, device=dev)
+        if t is None:
+            t = xp.zeros((3,), dtype=dt, device=dev)
+        A = xp.asarray(A, dtype=dt)
+        t = xp.asarray(t, dtype=dt)
+        batch = tuple(np.broadcast_shapes(tuple(A.shape[:-2]), tuple(t.shape[:-1])))
+        data = xp.concat(
+            [
+                xp.broadcast_to(A, batch + (3, 3)),
+                xp.broadcast_to(t[..., None], batch + (3, 1)),
+            ],
+            axis=-1,
+        )
+        tol = singular_rtol(data.dtype) if rtol is None else rtol
+        check_invertible(_k.affine_hadamard_ratio(data), tol, "affine matrix A")
+        self._data = data
+
+    @classmethod
+    def _wrap(cls, data):
+        obj = cls.__new__(cls)
+        obj._data = data
+        return obj
+
+    @classmethod
+    def from_matrix(cls, matrix, *, atol=None, rtol=None):
+        """From homogeneous matrices ``[[A, t], [0, 1]]``, shape (..., 4, 4), validated.
+
+        Raises
+        ------
+        NonFiniteError
+            NaN or infinity anywhere.
+        NotAffineError
+            The bottom row differs from ``[0, 0, 0, 1]`` by more than ``atol``
+            (default 1e-6 for float64, 1e-4 for float32), naming the batch index.
+        SingularMatrixError
+            ``A`` is singular (see the class docs), naming the batch index.
+        """
+        M = _as_float(as_array(matrix, (4, 4), "homogeneous matrix"))
+        check_finite(M, (4, 4), "homogeneous matrix")
+        check_bottom_row(M, atol, "an affine transform", NotAffineError)
+        return cls(matrix=M[..., :3, :3], translation=M[..., :3, 3], rtol=rtol)
+
+    @classmethod
+    def from_similarity(cls, similarity):
+        """The inclusion: a :class:`~rigidkit.Similarity` (or a ``Transform`` or
+        ``Rotation``) as the affine map ``[[s R, t], [0, 1]]``."""
+        _include_check(cls, similarity, "Affine.from_similarity")
+        return cls._include(similarity)
+
+    @classmethod
+    def _include(cls, x):
+        if type(x) is cls:
+            return x
+        return cls._wrap(homogeneous_matrix(x)[..., :3, :])
+
+    @classmethod
+    def identity(cls, shape=(), *, dtype=None):
+        """Identity transforms of batch ``shape``."""
+        shape = (shape,) if isinstance(shape, int) else tuple(shape)
+        data = np.zeros(shape + (3, 4), dtype=dtype or np.float64)
+        data[..., range(3), range(3)] = 1.0
+        return cls._wrap(data)
+
+    @classmethod
+    def random(cls, shape=(), rng=None, *, dtype=None):
+        """Random transforms: ``A`` = identity + standard normal / 2, ``t`` standard normal.
+
+        Invertible with probability 1; ``rng`` is a Generator or a seed.
+        """
+        shape = (shape,) if isinstance(shape, int) else tuple(shape)
+        rng = np.random.default_rng(rng)
+        A = np.eye(3) + 0.5 * rng.standard_normal(shape + (3, 3))
+        t = rng.standard_normal(shape + (3,))
+        if dtype is not None:
+            A, t = A.astype(dtype), t.astype(dtype)
+        return cls(matrix=A, translation=t)
+
+    # -- representations ------------------------------------------------------------
+    @property
+    def matrix(self):
+        """The linear part ``A``, shape (..., 3, 3)."""
+        return self._data[..., :3]
+
+    @property
+    def translation(self):
+        """The translation ``t``, shape (..., 3)."""
+        return self._data[..., 3]
+
+    def as_matrix(self):
+        """Homogeneous matrices ``[[A, t], [0, 1]]``, shape (..., 4, 4)."""
+        xp = namespace_of(self._data)
+        last = xp.asarray(
+            [0.0, 0.0, 0.0, 1.0], dtype=self._data.dtype, device=device_of(self._data)
+        )
+        last = xp.broadcast_to(last, self.shape + (1, 4))
+        return xp.concat([self._data, last], axis=-2)
+
+    def as_projective(self):
+        """The same transforms as :class:`~rigidkit.Projective`."""
+        return Projective._include(self)
+
+    # -- operations --------------------------------------------------------------------
+    def _compose(self, other):
+        return Affine._wrap(_k.affine_compose(self._data, other._data))
+
+    def apply(self, points):
+        """``A p + t`` for points of shape (..., 3), broadcasting with the batch shape."""
+        return _k.affine_apply(self._data, as_array(points, (3,), "points"))
+
+    def inv(self, *, rtol=None):
+        """Inverse transforms ``[A^-1 | -A^-1 t]``.
+
+        Raises :class:`~rigidkit.SingularMatrixError` if ``A`` became singular to
+        working precision (a product of ill-conditioned factors can).
+        """
+        inv, ratio = _k.affine_inverse(self._data)
+        tol = singular_rtol(self._data.dtype) if rtol is None else rtol
+        check_invertible(ratio, tol, "affine matrix A")
+        return Affine._wrap(inv)
+
+    def approx_equal(self, other, *, atol=1e-12):
+        """Elementwise ``max |[A1 | t1] - [A2 | t2]| <= atol``, shape (...)."""
+        other = Affine._include(other)
+        xp = namespace_of(self._data, other._data)
+        close = xp.abs(self._data - other._data) <= atol
+        return xp.all(xp.reshape(close, self.shape + (12,)), axis=-1)
+
+    # -- container protocol ----------------------------------------------------------------
+    @property
+    def shape(self) -> tuple:
+        """Batch shape (``()`` for one transform)."""
+        return tuple(self._data.shape[:-2])
+
+    @property
+    def dtype(self):
+        return self._data.dtype
+
+    def __len__(self):
+        if not self.shape:
+            raise TypeError("a single Affine has no len()")
+        return self._data.shape[0]
+
+    def __getitem__(self, index):
+        if not self.shape:
+            raise TypeError("a single Affine cannot be indexed")
+        if not isinstance(index, tuple):
+            index = (index,)
+        return Affine._wrap(self._data[index + (slice(None), slice(None))])
+
+    def __repr__(self):
+        if not self.shape:
+            d = _to_numpy(self._data).tolist()
+            A = [row[:3] for row in d]
+            t = [row[3] for row in d]
+            return f"Affine(matrix={A!r}, translation={t!r})"
+        return f"Affine(shape={self.shape}, dtype={self._data.dtype})"
+
+    def __reduce__(self):
+        return (Affine._wrap, (self._data,))
+
+
+def check_bottom_row(M, atol, kind, error):
+    """Raise ``error`` where the bottom row of ``M`` (..., 4, 4) is not ``[0, 0, 0, 1]``."""
+    xp = namespace_of(M)
+    tol = default_atol(M.dtype) if atol is None else atol
+    bottom = M[..., 3, :]
+    bad = xp.any(xp.abs(bottom[..., :3]) > tol, axis=-1) | (
+        xp.abs(bottom[..., 3] - 1.0) > tol
+    )
+    if bool(xp.any(bad)):
+        idx = batch_index(bad)
+        row = _to_numpy(bottom)[idx].tolist()
+        raise error(
+            f"homogeneous matrix {where_text(idx)} is not {kind}: bottom row {row} is not "
+            f"[0, 0, 0, 1] (tolerance {tol:g})"
+        )
+
+
+def _result_dtype(xp, a, b):
+    if isinstance(a, np.ndarray) and isinstance(b, np.ndarray):
+        return np.result_type(a, b)
+    return a.dtype if a.dtype == b.dtype else xp.float64

@@ -1,0 +1,462 @@
+"""The quaternion algebra ``H``: general (not necessarily unit) quaternions.
+
+Components ``(w, x, y, z)`` = ``w + x i + y j + z k``, scalar first; Hamilton
+convention ``i^2 = j^2 = k^2 = ijk = -1`` (so ``ij = k``). Rotations use only unit
+quaternions (:class:`rigidkit.Rotation`); this module is the whole algebra: sums,
+the Hamilton product, conjugate, norm, inverse ``q* / |q|^2``, ``exp`` and ``log``,
+and the 4x4 matrices of left and right multiplication.
+
+The functions take and return arrays of shape (..., 4), batched over leading axes
+(broadcasting like NumPy), in the array namespace and dtype of their input;
+:class:`Quaternion` wraps one such array.
+
+Operators of :class:`Quaternion`, one meaning each: ``+`` and ``-`` add,
+``*`` is the Hamilton product (or, with a real scalar, scalar multiplication),
+``/`` divides by a real scalar only. ``@`` is not defined: in rigidkit ``@``
+means composing transforms or acting on points, and a general quaternion is
+neither; rotate points with :meth:`Quaternion.rotate` or ``q.to_rotation() @ p``.
+
+>>> import numpy as np
+>>> i = Quaternion([0.0, 1.0, 0.0, 0.0])
+>>> j = Quaternion([0.0, 0.0, 1.0, 0.0])
+>>> i * j                                  # ij = k
+Quaternion([0.0, 0.0, 0.0, 1.0])
+>>> np.asarray(i * i)                      # i^2 = -1
+array([-1.,  0.,  0.,  0.])
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import conversions as _conv
+from ._engine.namespace import is_numpy, namespace_of
+from ._validate import as_array, batch_index, check_finite, where_text
+from .errors import ZeroNormError
+from .kernels import quaternion as _kq
+from .kernels import quaternion_algebra as _ka
+from .projective import any_true
+
+__all__ = [
+    "Quaternion",
+    "multiply",
+    "conjugate",
+    "norm",
+    "inv",
+    "exp",
+    "log",
+    "left_matrix",
+    "right_matrix",
+    "rotate",
+]
+
+
+def _quat(q, what="quaternion"):
+    """``q`` as a float array of shape (..., 4) of its own namespace."""
+    q = as_array(q, (4,), what)
+    if isinstance(q, np.ndarray) and q.dtype.kind != "f":
+        q = q.astype(np.float64)
+    return q
+
+
+def _reject_zero(result, largest, what):
+    """``result``, unless ``largest`` (the largest |component|) is 0 somewhere."""
+    zero = largest == 0.0
+    if any_true(zero):
+        where = where_text(batch_index(zero))
+        raise ZeroNormError(f"{what} is the zero quaternion {where}")
+    return result
+
+
+def multiply(q1, q2):
+    """Hamilton product ``q1 q2``, shapes (..., 4) broadcasting.
+
+    ``q1 q2 = (w1 w2 - v1.v2, w1 v2 + w2 v1 + v1 x v2)``; not commutative.
+
+    >>> multiply([0.0, 0.0, 1.0, 0.0], [0.0, 1.0, 0.0, 0.0])   # ji = -k
+    array([ 0.,  0.,  0., -1.])
+    """
+    return _kq.quat_multiply(_quat(q1), _quat(q2))
+
+
+def conjugate(q):
+    """Conjugate ``q* = (w, -v)``, shape (..., 4); ``(q1 q2)* = q2* q1*``."""
+    return _kq.quat_conjugate(_quat(q))
+
+
+def norm(q):
+    """Euclidean norm ``|q| = sqrt(w^2 + |v|^2)``, shape (...), without overflow.
+
+    ``|q1 q2| = |q1| |q2|``.
+    """
+    return _kq.quat_normalize(_quat(q))[1]
+
+
+def inv(q):
+    """Multiplicative inverse ``q^-1 = q* / |q|^2``, shape (..., 4).
+
+    (The notes write ``q* / |q|``, which is wrong unless ``|q| = 1``.)
+    ``q q^-1 = q^-1 q = 1``.
+
+    Raises
+    ------
+    ZeroNormError
+        For a zero quaternion, naming its batch index.
+
+    >>> inv([0.0, 2.0, 0.0, 0.0])                 # (2i)^-1 = -i/2
+    array([ 0. , -0.5, -0. , -0. ])
+    """
+    return _reject_zero(*_ka.quat_inverse(_quat(q)), "inverse of a quaternion")
+
+
+def exp(q):
+    """Exponential ``exp(w + v) = e^w (cos|v|, sin(|v|) v / |v|)``, shape (..., 4).
+
+    Defined for every quaternion (the series ``sum q^n / n!``); exact for tiny
+    ``|v|`` (``sinc`` series). ``exp(q1 + q2) = exp(q1) exp(q2)`` only when ``q1`` and
+    ``q2`` commute. For a pure ``q = (0, theta/2 u)`` it is the unit quaternion
+    of the rotation by ``theta`` about ``u``.
+
+    >>> np.round(exp([0.0, 0.0, 0.0, np.pi / 2]), 12) + 0.0   # e^(k pi/2) = k
+    array([0., 0., 0., 1.])
+
+    See Also
+    --------
+    log
+    """
+    q = _quat(q)
+    check_finite(q, (4,), "quaternion")
+    return _ka.quat_exp(q)
+
+
+def log(q):
+    """Principal logarithm ``(log|q|, theta v / |v|)``, ``theta = atan2(|v|, w)``.
+
+    ``theta`` is in [0, pi], so ``exp(log(q)) = q`` for every nonzero ``q`` and
+    ``log(exp(p)) = p`` when ``|vector(p)| < pi``. On the negative real axis
+    (``v = 0``, ``w < 0``) the logarithm is not unique (``log|w| + pi u`` for any
+    unit ``u``); we return ``(log|w|, pi, 0, 0)``, i.e. ``u = i``.
+
+    Raises
+    ------
+    ZeroNormError
+        For a zero quaternion (log 0 is undefined), naming its batch index.
+
+    >>> np.round(log([-1.0, 0.0, 0.0, 0.0]), 12) + 0.0           # log(-1) = i pi
+    array([0.        , 3.14159265, 0.        , 0.        ])
+
+    See Also
+    --------
+    exp
+    """
+    q = _quat(q)
+    check_finite(q, (4,), "quaternion")
+    return _reject_zero(*_ka.quat_log(q), "logarithm of a quaternion")
+
+
+def left_matrix(q):
+    """``q+``, shape (..., 4, 4), with ``q p == q+ @ p`` for 4-vectors ``p``.
+
+    ``q+ = [[w, -v^T], [v, w I + hat(v)]]`` (left multiplication by ``q``).
+    ``q -> q+`` is an algebra homomorphism: ``(q1 q2)+ = q1+ q2+``.
+    """
+    return _ka.quat_left_matrix(_quat(q))
+
+
+def right_matrix(q):
+    """``q(+)``, shape (..., 4, 4), with ``p q == q(+) @ p`` for 4-vectors ``p``.
+
+    ``q(+) = [[w, -v^T], [v, w I - hat(v)]]`` (right multiplication by ``q``).
+    """
+    return _ka.quat_right_matrix(_quat(q))
+
+
+def rotate(q, points):
+    """``q p q^-1`` for 3-vectors ``p`` (as pure quaternions), shape (..., 3).
+
+    Works for any nonzero ``q``: the scale of ``q`` cancels, so this is the
+    rotation by ``q / |q|`` (active, Hamilton; :meth:`rigidkit.Rotation.apply`).
+
+    Raises
+    ------
+    ZeroNormError
+        For a zero quaternion.
+    """
+    unit = _conv.quat_normalize(_quat(q), what="quaternion")
+    p = as_array(points, (3,), "points")
+    return _kq.quat_apply(unit, p)
+
+
+def _numpy_of(a):
+    if isinstance(a, np.ndarray):
+        return a
+    if hasattr(a, "detach"):
+        return a.detach().cpu().numpy()
+    return np.asarray(a)
+
+
+class Quaternion:
+    """A batch of general quaternions ``w + x i + y j + z k``, shape (..., 4).
+
+    Hamilton convention (``ij = k``), scalar first. Operators: ``q1 + q2``,
+    ``q1 - q2``, ``-q``, ``q1 * q2`` (Hamilton product), ``s * q`` and ``q * s``
+    (scalar multiplication by real numbers or arrays of the batch shape), ``q / s``
+    (real ``s`` only). A non-quaternion operand of ``*`` is always a real scalar
+    per batch element, so wrap 4-vectors as ``Quaternion(a)`` to multiply by them.
+    ``@`` is not defined (module docs). ``np.asarray(q)`` gives the components.
+
+    Parameters
+    ----------
+    components : array_like, shape (..., 4)
+        ``(w, x, y, z)``; finite. Integer input becomes float64; the array
+        namespace (NumPy, torch, ...) and float dtype are kept.
+
+    Examples
+    --------
+    >>> q = Quaternion([1.0, 2.0, 3.0, 4.0])
+    >>> np.round(np.asarray(q * q.inv()), 12) + 0.0
+    array([1., 0., 0., 0.])
+    >>> q.conjugate() * q                      # |q|^2 = 30
+    Quaternion([30.0, 0.0, 0.0, 0.0])
+    >>> (2 * q).w
+    array(2.)
+    """
+
+    __slots__ = ("_q",)
+    # NumPy's binary operators defer to ours (ndarray * Quaternion -> __rmul__).
+    __array_ufunc__ = None
+
+    def __init__(self, components):
+        q = _quat(components, "quaternion components")
+        check_finite(q, (4,), "quaternion components")
+        self._q = q
+
+    @classmethod
+    def _wrap(cls, q):
+        obj = cls.__new__(cls)
+        obj._q = q
+        return obj
+
+    @classmethod
+    def from_parts(cls, scalar, vector):
+        """From the scalar part (shape (...)) and the vector part (shape (..., 3)).
+
+        >>> Quaternion.from_parts(0.0, [1.0, 2.0, 3.0])   # a pure quaternion
+        Quaternion([0.0, 1.0, 2.0, 3.0])
+        """
+        v = as_array(vector, (3,), "vector part")
+        xp = namespace_of(v, scalar)
+        if is_numpy(xp):
+            s = scalar if isinstance(scalar, (int, float)) else np.asarray(scalar)
+            dt = np.result_type(v, s)
+            dt = dt if dt.kind == "f" else np.dtype(np.float64)
+            v = np.asarray(v, dtype=dt)
+            s = np.asarray(s, dtype=dt)
+        else:
+            s = xp.asarray(scalar, dtype=v.dtype)
+        batch = tuple(np.broadcast_shapes(tuple(s.shape), tuple(v.shape[:-1])))
+        parts = [
+            xp.broadcast_to(s[..., None], batch + (1,)),
+            xp.broadcast_to(v, batch + (3,)),
+        ]
+        return cls(xp.concat(parts, axis=-1))
+
+    @classmethod
+    def from_rotation(cls, rotation):
+        """The unit quaternions of a :class:`~rigidkit.Rotation` (either sign)."""
+        return cls._wrap(rotation.as_quat())
+
+    def to_rotation(self):
+        """The :class:`~rigidkit.Rotation` of ``q / |q|``.
+
+        Raises
+        ------
+        ZeroNormError
+            For a zero quaternion, naming its batch index.
+        """
+        from .rotation import Rotation
+
+        return Rotation.from_quat(self._q)
+
+    # -- components ---------------------------------------------------------------
+    @property
+    def w(self):
+        """Scalar (real) part, shape (...)."""
+        return self._q[..., 0]
+
+    @property
+    def x(self):
+        """Coefficient of ``i``, shape (...)."""
+        return self._q[..., 1]
+
+    @property
+    def y(self):
+        """Coefficient of ``j``, shape (...)."""
+        return self._q[..., 2]
+
+    @property
+    def z(self):
+        """Coefficient of ``k``, shape (...)."""
+        return self._q[..., 3]
+
+    scalar = w
+
+    @property
+    def vector(self):
+        """Vector (imaginary) part ``(x, y, z)``, shape (..., 3)."""
+        return self._q[..., 1:]
+
+    def __array__(self, dtype=None, copy=None):
+        a = _numpy_of(self._q)
+        if dtype is not None:
+            a = a.astype(dtype, copy=False)
+        return a.copy() if copy else a
+
+    # -- algebra ------------------------------------------------------------------
+    def __add__(self, other):
+        if not isinstance(other, Quaternion):
+            return NotImplemented
+        return Quaternion._wrap(self._q + other._q)
+
+    def __sub__(self, other):
+        if not isinstance(other, Quaternion):
+            return NotImplemented
+        return Quaternion._wrap(self._q - other._q)
+
+    def __neg__(self):
+        return Quaternion._wrap(-self._q)
+
+    def __pos__(self):
+        return self
+
+    def __mul__(self, other):
+        if isinstance(other, Quaternion):
+            return Quaternion._wrap(_kq.quat_multiply(self._q, other._q))
+        s = self._scalar(other)
+        return NotImplemented if s is None else Quaternion._wrap(self._q * s)
+
+    def __rmul__(self, other):
+        s = self._scalar(other)
+        return NotImplemented if s is None else Quaternion._wrap(s * self._q)
+
+    def __truediv__(self, other):
+        if isinstance(other, Quaternion):
+            raise TypeError(
+                "quaternion / quaternion is ambiguous (the product does not commute); "
+                "write q1 * q2.inv() or q2.inv() * q1"
+            )
+        s = self._scalar(other)
+        return NotImplemented if s is None else Quaternion._wrap(self._q / s)
+
+    def __matmul__(self, other):
+        raise TypeError(
+            "@ is not defined for Quaternion: use * for the Hamilton product, "
+            "q.rotate(p) or q.to_rotation() @ p to rotate points"
+        )
+
+    __rmatmul__ = __matmul__
+
+    def _scalar(self, s):
+        """A real scalar (or batch of them) as an array that broadcasts against ``_q``."""
+        if isinstance(s, bool):
+            return None
+        if isinstance(s, (int, float)):
+            return s
+        if isinstance(s, np.generic) and s.dtype.kind in "fiu":
+            return s
+        if isinstance(s, complex) or getattr(getattr(s, "dtype", None), "kind", "") == "c":
+            raise TypeError("a quaternion's scalar factor must be real")
+        if not hasattr(s, "shape") and not isinstance(s, (list, tuple)):
+            return None
+        xp = namespace_of(self._q, s)
+        if is_numpy(xp):
+            s = np.asarray(s)
+            if s.dtype.kind not in "fiu":
+                return None
+        else:
+            s = xp.asarray(s)
+        return s[..., None]
+
+    def conjugate(self):
+        """``q* = (w, -v)``."""
+        return Quaternion._wrap(_kq.quat_conjugate(self._q))
+
+    def norm(self):
+        """``|q|``, shape (...)."""
+        return _kq.quat_normalize(self._q)[1]
+
+    def inv(self):
+        """``q^-1 = q* / |q|^2`` (raises :class:`~rigidkit.ZeroNormError` for 0)."""
+        return Quaternion._wrap(inv(self._q))
+
+    def exp(self):
+        """``exp(q)``; see :func:`rigidkit.quaternion.exp`."""
+        return Quaternion._wrap(_ka.quat_exp(self._q))
+
+    def log(self):
+        """Principal ``log(q)``; see :func:`rigidkit.quaternion.log`."""
+        log_q = _reject_zero(*_ka.quat_log(self._q), "logarithm of a quaternion")
+        return Quaternion._wrap(log_q)
+
+    def left_matrix(self):
+        """``q+`` (..., 4, 4) with ``(q * p) == q.left_matrix() @ p`` as 4-vectors."""
+        return _ka.quat_left_matrix(self._q)
+
+    def right_matrix(self):
+        """``q(+)`` (..., 4, 4) with ``(p * q) == q.right_matrix() @ p`` as 4-vectors."""
+        return _ka.quat_right_matrix(self._q)
+
+    def rotate(self, points):
+        """``q p q^-1`` for points ``p`` (..., 3), any nonzero ``q``; see :func:`rotate`."""
+        return rotate(self._q, points)
+
+    def approx_equal(self, other, *, atol=1e-12, rtol=0.0):
+        """``|q_i - o_i| <= atol + rtol |o_i|`` for all four components; shape (...).
+
+        Componentwise (``q`` and ``-q`` differ here, unlike for rotations).
+        """
+        xp = namespace_of(self._q, other._q)
+        close = xp.abs(self._q - other._q) <= atol + rtol * xp.abs(other._q)
+        return xp.all(close, axis=-1)
+
+    # -- container protocol ---------------------------------------------------------
+    @property
+    def shape(self) -> tuple:
+        """Batch shape (``()`` for one quaternion)."""
+        return tuple(self._q.shape[:-1])
+
+    @property
+    def dtype(self):
+        return self._q.dtype
+
+    def __len__(self):
+        if self._q.ndim == 1:
+            raise TypeError("a single Quaternion has no len()")
+        return self._q.shape[0]
+
+    def __getitem__(self, index):
+        if self._q.ndim == 1:
+            raise TypeError("a single Quaternion cannot be indexed")
+        if not isinstance(index, tuple):
+            index = (index,)
+        return Quaternion._wrap(self._q[index + (slice(None),)])
+
+    def __iter__(self):
+        if self._q.ndim == 1:
+            raise TypeError("a single Quaternion is not iterable")
+        for k in range(len(self)):
+            yield self[k]
+
+    def __repr__(self):
+        if self._q.ndim == 1:
+            vals = ", ".join(repr(float(c)) for c in _numpy_of(self._q))
+            return f"Quaternion([{vals}])"
+        return f"Quaternion(shape={self.shape}, dtype={self._q.dtype})"
+
+    def __reduce__(self):
+        return (Quaternion._wrap, (self._q,))
+
+    def __eq__(self, other):  # object identity; compare values with approx_equal
+        return NotImplemented if not isinstance(other, Quaternion) else self is other
+
+    __hash__ = object.__hash__

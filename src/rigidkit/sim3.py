@@ -1,0 +1,87 @@
+"""The Lie group Sim(3) in functional form: hat, vee, exp, log, adjoint, ad, bracket.
+
+Twists are ordered ``(v, omega, sigma)`` (7 components), ``sigma = log s``:
+``hat(xi) = [[hat(omega) + sigma I, v], [0, 0]]``, extending the SE(3) order
+``(v, omega)``. Group elements are homogeneous matrices ``[[s R, t], [0, 1]]``
+(arrays in, arrays out); :class:`rigidkit.Similarity` is the object form. Closed
+forms and their series are in :mod:`rigidkit.kernels.sim3`.
+
+>>> import numpy as np
+>>> xi = np.array([0.1, -0.2, 0.3, 0.4, 0.5, -0.6, 0.7])
+>>> bool(np.allclose(log(exp(xi)), xi))
+True
+>>> bool(np.array_equal(vee(hat(xi)), xi))
+True
+"""
+
+from __future__ import annotations
+
+from ._validate import as_array, check_finite
+from .kernels import sim3 as _k
+
+__all__ = ["hat", "vee", "exp", "log", "adjoint", "ad", "bracket"]
+
+
+def _twist(xi, what="sim(3) twist"):
+    return as_array(xi, (7,), what)
+
+
+def hat(xi):
+    """``[[hat(omega) + sigma I, v], [0, 0]]``: shape (..., 7) -> (..., 4, 4)."""
+    return _k.sim3_hat(_twist(xi))
+
+
+def vee(X):
+    """Twist of a sim(3) matrix (its projection onto sim(3)): (..., 4, 4) -> (..., 7).
+
+    ``omega`` from the skew part and ``sigma`` the mean of the diagonal of the 3x3
+    block; ``vee(hat(xi)) == xi`` exactly.
+    """
+    return _k.sim3_vee(as_array(X, (4, 4), "sim(3) matrix"))
+
+
+def exp(xi):
+    """Homogeneous matrix ``expm(hat(xi)) = [[e^sigma R, V v], [0, 1]]``, shape (..., 4, 4).
+
+    See :meth:`rigidkit.Similarity.exp` for the closed form.
+    """
+    from .similarity import Similarity
+
+    return Similarity.exp(xi).as_matrix()
+
+
+def log(M, *, atol=None):
+    """Twist ``(v, omega, log s)``, ``|omega|`` in [0, pi], of ``[[s R, t], [0, 1]]``.
+
+    Validated like :meth:`rigidkit.Similarity.from_matrix` (raises
+    :class:`~rigidkit.NotASimilarityError` naming the batch index).
+    """
+    from .similarity import Similarity
+
+    return Similarity.from_matrix(M, atol=atol).log()
+
+
+def adjoint(M, *, atol=None):
+    """``Ad(M) = [[s R, hat(t) R, -t], [0, R, 0], [0, 0, 1]]`` (..., 7, 7) of
+    ``[[s R, t], [0, 1]]``: ``M hat(xi) M^-1 = hat(Ad xi)``."""
+    from .similarity import Similarity
+
+    return Similarity.from_matrix(M, atol=atol).adjoint()
+
+
+def ad(xi):
+    """Small adjoint ``[[hat(w) + sigma I, hat(v), -v], [0, hat(w), 0], [0, 0, 0]]``.
+
+    ``ad(xi1) @ xi2 == bracket(xi1, xi2)``; ``adjoint(exp(xi)) == expm(ad(xi))``.
+    """
+    xi = _twist(xi)
+    check_finite(xi, (7,), "sim(3) twist")
+    return _k.sim3_ad(xi)
+
+
+def bracket(xi1, xi2):
+    """Lie bracket ``vee(hat(xi1) hat(xi2) - hat(xi2) hat(xi1))``, shape (..., 7).
+
+    ``= (w1 x v2 - w2 x v1 + s1 v2 - s2 v1, w1 x w2, 0)`` for ``xi = (v, w, s)``.
+    """
+    return _k.sim3_bracket(_twist(xi1), _twist(xi2))
