@@ -57,3 +57,152 @@ def log(R, *, atol=None):
         Tolerance of the SO(3) check, see :func:`rigidkit.conversions.quat_from_matrix`.
     """
     return _rv.rotvec_from_quat(_conv.quat_from_matrix(R, atol=atol))
+
+
+# -- Lie calculus (appended with the SE(3) work) ---------------------------------------
+# Jacobian conventions, for rotation vectors w and small d:
+#   left:  exp(w + d) ~ exp(J_l(w) d) exp(w)     right: exp(w + d) ~ exp(w) exp(J_r(w) d)
+#   J_r(w) = J_l(-w) = J_l(w)^T.
+
+from .kernels import so3_jacobians as _jac  # noqa: E402
+
+__all__ += [
+    "adjoint",
+    "ad",
+    "bracket",
+    "left_jacobian",
+    "right_jacobian",
+    "left_jacobian_inverse",
+    "right_jacobian_inverse",
+]
+
+
+def _rotvec(w):
+    w = as_array(w, (3,), "rotation vector")
+    check_finite(w, (3,), "rotation vector")
+    return w
+
+
+def adjoint(R):
+    """Adjoint of SO(3), the rotation matrix itself: ``R hat(w) R^T = hat(R w)``.
+
+    Parameters
+    ----------
+    R : array_like, shape (..., 3, 3)
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+    """
+    return as_array(R, (3, 3), "rotation matrix")
+
+
+def ad(w):
+    """Small adjoint of so(3), ``hat(w)``: ``ad(u) @ v == bracket(u, v) == u x v``.
+
+    Parameters
+    ----------
+    w : array_like, shape (..., 3)
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+    """
+    return hat(w)
+
+
+def bracket(u, v):
+    """Lie bracket of so(3): ``vee(hat(u) hat(v) - hat(v) hat(u)) = u x v``.
+
+    Parameters
+    ----------
+    u, v : array_like, shape (..., 3)
+        Batch shapes broadcast.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+
+    >>> bracket([1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+    array([0., 0., 1.])
+    """
+    u = as_array(u, (3,), "so(3) vector")
+    return _jac.bracket(u, as_array(v, (3,), "so(3) vector"))
+
+
+def left_jacobian(w):
+    """Left Jacobian of SO(3): ``exp(w + d) ~ exp(J_l(w) d) exp(w)`` to first order.
+
+    ``J_l = I + (1 - cos t)/t^2 hat(w) + (t - sin t)/t^3 hat(w)^2`` with ``t = |w|``
+    (small-angle series in the coefficient helpers); also ``sum_k hat(w)^k/(k+1)!``.
+
+    Parameters
+    ----------
+    w : array_like, shape (..., 3)
+        Rotation vectors, radians.
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+
+    See Also
+    --------
+    right_jacobian, left_jacobian_inverse
+
+    >>> import numpy as np
+    >>> np.round(left_jacobian([0.0, 0.0, np.pi / 2]), 6) + 0.0  # 2/pi = 0.63662
+    array([[ 0.63662, -0.63662,  0.     ],
+           [ 0.63662,  0.63662,  0.     ],
+           [ 0.     ,  0.     ,  1.     ]])
+    """
+    return _jac.left_jacobian(_rotvec(w))
+
+
+def right_jacobian(w):
+    """Right Jacobian of SO(3): ``exp(w + d) ~ exp(w) exp(J_r(w) d)``; ``J_r(w) = J_l(-w)``.
+
+    Parameters
+    ----------
+    w : array_like, shape (..., 3)
+        Rotation vectors, radians.
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+
+    See Also
+    --------
+    left_jacobian, right_jacobian_inverse
+    """
+    return _jac.left_jacobian(-_rotvec(w))
+
+
+def left_jacobian_inverse(w):
+    """Inverse of :func:`left_jacobian`: ``log(exp(d) exp(w)) ~ w + J_l(w)^-1 d``.
+
+    ``J_l^-1 = I - hat(w)/2 + (1 - (t/2) cot(t/2))/t^2 hat(w)^2``, finite for
+    ``t = |w| < 2 pi``.
+
+    Parameters
+    ----------
+    w : array_like, shape (..., 3)
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+    """
+    return _jac.left_jacobian_inverse(_rotvec(w))
+
+
+def right_jacobian_inverse(w):
+    """Inverse of :func:`right_jacobian`: ``log(exp(w) exp(d)) ~ w + J_r(w)^-1 d``.
+
+    Parameters
+    ----------
+    w : array_like, shape (..., 3)
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+    """
+    return _jac.left_jacobian_inverse(-_rotvec(w))

@@ -1,0 +1,316 @@
+"""The Lie group SE(3) in functional form (arrays in, arrays out, batched).
+
+Conventions: twists are ordered ``(v, w)`` as in the notes, ``V = [v; w]``, with
+``hat(V) = [[hat(w), v], [0, 0]]`` (scipy's exponential coordinates are ``(w, v)``).
+Homogeneous matrices ``[[R, t], [0, 1]]`` act on column vectors ``[p; 1]``; poses
+are arrays ``(w, x, y, z, tx, ty, tz)`` (unit quaternion, Hamilton, scalar first,
+then translation).
+
+======================  ==========================================================
+``exp(V)``              ``expm(hat(V)) = [[R, J_l(w) v], [0, 1]]``, ``R = exp(hat(w))``
+``log(M)``              twist with ``|w|`` in [0, pi] and ``v = J_l(w)^-1 t``
+``adjoint(M)``          ``Ad = [[R, hat(t) R], [0, R]]``: ``M exp(V) M^-1 = exp(Ad V)``
+``ad(V)``               ``[[hat(w), hat(v)], [0, hat(w)]]``: ``ad(V) U = [V, U]``
+``bracket(V, U)``       ``vee(hat(V) hat(U) - hat(U) hat(V))``
+``left_jacobian(V)``    ``exp(V + d) ~ exp(J_l d) exp(V)``; ``[[J_l(w), Q], [0, J_l(w)]]``
+``right_jacobian(V)``   ``exp(V + d) ~ exp(V) exp(J_r d)``; ``J_r(V) = J_l(-V)``
+======================  ==========================================================
+
+>>> import numpy as np
+>>> V = np.array([1.0, 0.0, 0.0, 0.0, 0.0, np.pi / 2])  # (v, w): screw about z
+>>> np.round(exp(V), 12) + 0.0
+array([[ 0.        , -1.        ,  0.        ,  0.63661977],
+       [ 1.        ,  0.        ,  0.        ,  0.63661977],
+       [ 0.        ,  0.        ,  1.        ,  0.        ],
+       [ 0.        ,  0.        ,  0.        ,  1.        ]])
+>>> bool(np.allclose(log(exp(V)), V))
+True
+"""
+
+from __future__ import annotations
+
+from . import conversions as _conv
+from ._engine.namespace import namespace_of
+from ._validate import _to_numpy, as_array, batch_index, check_finite, where_text
+from .errors import NotARotationError
+from .kernels import se3 as _k
+
+__all__ = [
+    "hat",
+    "vee",
+    "exp",
+    "log",
+    "adjoint",
+    "ad",
+    "bracket",
+    "left_jacobian",
+    "right_jacobian",
+    "left_jacobian_inverse",
+    "right_jacobian_inverse",
+    "pose_from_matrix",
+    "matrix_from_pose",
+    "pose_from_twist",
+    "twist_from_pose",
+]
+
+matrix_from_pose = _k.matrix_from_pose
+twist_from_pose = _k.twist_from_pose
+
+
+def _twist(xi, what="twist"):
+    xi = as_array(xi, (6,), what)
+    check_finite(xi, (6,), what)
+    return xi
+
+
+def hat(xi):
+    """``hat(V) = [[hat(w), v], [0, 0]]`` of twists ``V = (v, w)``.
+
+    Parameters
+    ----------
+    xi : array_like, shape (..., 6)
+
+    Returns
+    -------
+    ndarray, shape (..., 4, 4)
+
+    See Also
+    --------
+    vee
+    """
+    return _k.hat(as_array(xi, (6,), "twist"))
+
+
+def vee(X):
+    """Twist ``(v, w)`` of 4x4 se(3) matrices: ``v`` the last column, ``w`` the skew part.
+
+    Parameters
+    ----------
+    X : array_like, shape (..., 4, 4)
+
+    Returns
+    -------
+    ndarray, shape (..., 6)
+
+    See Also
+    --------
+    hat
+    """
+    return _k.vee(as_array(X, (4, 4), "se(3) matrix"))
+
+
+def pose_from_twist(xi):
+    """Pose ``(w, x, y, z, tx, ty, tz)`` of ``exp(hat(xi))``, twists ``(v, w)`` (..., 6)."""
+    return _k.pose_from_twist(_twist(xi))
+
+
+def exp(xi):
+    """Homogeneous matrix ``expm(hat(V))`` of twists ``V = (v, w)``.
+
+    ``exp(hat(V)) = [[R, J_l(w) v], [0, 1]]`` with ``R = exp(hat(w))`` (Rodrigues)
+    and ``J_l`` the SO(3) left Jacobian; for ``w = 0`` a pure translation by ``v``.
+    (The notes' ``hat(w) v (I - R)/|w|^2`` is wrong; see DESIGN.md errata.)
+
+    Parameters
+    ----------
+    xi : array_like, shape (..., 6)
+        Twists ``(v, w)``: ``w`` in radians, ``v`` in length units.
+
+    Returns
+    -------
+    ndarray, shape (..., 4, 4)
+
+    See Also
+    --------
+    log
+    """
+    return _k.matrix_from_pose(_k.pose_from_twist(_twist(xi)))
+
+
+def log(M, *, atol=None):
+    """Twist ``(v, w)`` of homogeneous matrices, with ``|w|`` in [0, pi].
+
+    ``w`` is the rotation vector of ``R`` and ``v = J_l(w)^-1 t``.
+
+    Parameters
+    ----------
+    M : array_like, shape (..., 4, 4)
+        Validated like :func:`pose_from_matrix`.
+    atol : float, optional
+        Tolerance of the validation.
+
+    Returns
+    -------
+    ndarray, shape (..., 6)
+
+    See Also
+    --------
+    exp
+    """
+    return _k.twist_from_pose(pose_from_matrix(M, atol=atol))
+
+
+def pose_from_matrix(M, *, atol=None, orthonormalize=False):
+    """Pose ``(w, x, y, z, tx, ty, tz)`` of homogeneous matrices ``[[R, t], [0, 1]]``.
+
+    Parameters
+    ----------
+    M : array_like, shape (..., 4, 4)
+    atol : float, optional
+        Largest accepted deviation of the bottom row from ``[0, 0, 0, 1]`` and of
+        ``R`` from SO(3) (see :func:`rigidkit.conversions.quat_from_matrix`); default
+        1e-6 (float64) or 1e-4 (float32).
+    orthonormalize : bool
+        Replace the rotation block by the nearest rotation instead of raising. The
+        bottom row is still checked.
+
+    Raises
+    ------
+    NonFiniteError
+        NaN or infinity anywhere.
+    NotARotationError
+        The bottom row is not ``[0, 0, 0, 1]`` or the rotation block is not a
+        rotation; the message names the first such batch index.
+    """
+    M = as_array(M, (4, 4), "homogeneous matrix")
+    check_finite(M, (4, 4), "homogeneous matrix")
+    xp = namespace_of(M)
+    tol = _conv.default_atol(M.dtype) if atol is None else atol
+    bottom = M[..., 3, :]
+    bad = xp.any(xp.abs(bottom[..., :3]) > tol, axis=-1) | (
+        xp.abs(bottom[..., 3] - 1.0) > tol
+    )
+    if bool(xp.any(bad)):
+        idx = batch_index(bad)
+        row = _to_numpy(bottom)[idx].tolist()
+        raise NotARotationError(
+            f"homogeneous matrix {where_text(idx)} is not a rigid transform: bottom "
+            f"row {row} is not [0, 0, 0, 1] (tolerance {tol:g})"
+        )
+    try:
+        q = _conv.quat_from_matrix(M[..., :3, :3], atol=atol, orthonormalize=orthonormalize)
+    except NotARotationError as err:
+        raise NotARotationError(f"rotation block of the homogeneous {err}") from None
+    return _k.pose_from_quat_translation(q, M[..., :3, 3])
+
+
+def adjoint(M):
+    """Adjoint ``[[R, hat(t) R], [0, R]]`` (6x6) of homogeneous ``[[R, t], [0, 1]]``.
+
+    For twists ``(v, w)``: ``M exp(V) M^-1 = exp(Ad V)`` and
+    ``M hat(V) M^-1 = hat(Ad V)``. The blocks are used as given (no validation).
+
+    Parameters
+    ----------
+    M : array_like, shape (..., 4, 4)
+
+    Returns
+    -------
+    ndarray, shape (..., 6, 6)
+    """
+    return _k.adjoint_from_matrix(as_array(M, (4, 4), "homogeneous matrix"))
+
+
+def ad(xi):
+    """Small adjoint ``ad(V) = [[hat(w), hat(v)], [0, hat(w)]]`` of twists ``(v, w)``.
+
+    ``ad(V) @ U == bracket(V, U)``; ``adjoint(exp(V)) == expm(ad(V))``.
+
+    Parameters
+    ----------
+    xi : array_like, shape (..., 6)
+
+    Returns
+    -------
+    ndarray, shape (..., 6, 6)
+    """
+    return _k.ad(as_array(xi, (6,), "twist"))
+
+
+def bracket(xi1, xi2):
+    """Lie bracket ``vee(hat(V1) hat(V2) - hat(V2) hat(V1))`` of twists ``(v, w)``.
+
+    Equals ``(w1 x v2 + v1 x w2, w1 x w2)``.
+
+    Parameters
+    ----------
+    xi1, xi2 : array_like, shape (..., 6)
+        Twists ``(v, w)``; batch shapes broadcast.
+
+    Returns
+    -------
+    ndarray, shape (..., 6)
+    """
+    return _k.bracket(as_array(xi1, (6,), "twist"), as_array(xi2, (6,), "twist"))
+
+
+def left_jacobian(xi):
+    """Left Jacobian of SE(3): ``exp(V + d) ~ exp(J_l(V) d) exp(V)`` to first order.
+
+    ``J_l = [[J_l(w), Q(v, w)], [0, J_l(w)]]`` for twists ``V = (v, w)``, with the
+    SO(3) left Jacobian ``J_l(w)`` and Barfoot's ``Q`` (small-angle series in its
+    coefficient helpers). It is also ``sum_k ad(V)^k / (k+1)!`` and the matrix
+    ``V`` of exp: ``exp(V) = [[R, J_l(w) v], [0, 1]]``.
+
+    Parameters
+    ----------
+    xi : array_like, shape (..., 6)
+
+    Returns
+    -------
+    ndarray, shape (..., 6, 6)
+
+    See Also
+    --------
+    right_jacobian, left_jacobian_inverse
+    """
+    return _k.left_jacobian(_twist(xi))
+
+
+def right_jacobian(xi):
+    """Right Jacobian of SE(3): ``exp(V + d) ~ exp(V) exp(J_r(V) d)``; ``J_r(V) = J_l(-V)``.
+
+    Parameters
+    ----------
+    xi : array_like, shape (..., 6)
+
+    Returns
+    -------
+    ndarray, shape (..., 6, 6)
+
+    See Also
+    --------
+    left_jacobian, right_jacobian_inverse
+    """
+    return _k.left_jacobian(-_twist(xi))
+
+
+def left_jacobian_inverse(xi):
+    """Inverse of :func:`left_jacobian`: ``log(exp(d) exp(V)) ~ V + J_l(V)^-1 d``.
+
+    ``[[J^-1, -J^-1 Q J^-1], [0, J^-1]]`` with ``J = J_l(w)``; finite for
+    ``|w| < 2 pi``.
+
+    Parameters
+    ----------
+    xi : array_like, shape (..., 6)
+
+    Returns
+    -------
+    ndarray, shape (..., 6, 6)
+    """
+    return _k.left_jacobian_inverse(_twist(xi))
+
+
+def right_jacobian_inverse(xi):
+    """Inverse of :func:`right_jacobian`: ``log(exp(V) exp(d)) ~ V + J_r(V)^-1 d``.
+
+    Parameters
+    ----------
+    xi : array_like, shape (..., 6)
+
+    Returns
+    -------
+    ndarray, shape (..., 6, 6)
+    """
+    return _k.left_jacobian_inverse(-_twist(xi))

@@ -1,0 +1,281 @@
+"""``Transform``: a batch of rigid motions SE(3), stored as unit quaternion + translation.
+
+Conventions: a transform ``A_T_B`` maps points of frame B to frame A,
+``p_A = A_T_B @ p_B = R p_B + t``; ``A_T_C = A_T_B @ B_T_C`` applies ``B_T_C`` first.
+Quaternions are Hamilton, scalar first; twists are ordered ``(v, w)`` as in the
+notes (scipy's exponential coordinates are ``(w, v)``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import conversions as _conv
+from . import se3 as _se3
+from ._engine.namespace import device_of, namespace_of
+from ._validate import _to_numpy, as_array, check_finite
+from .errors import ShapeError
+from .group import LieGroup
+from .kernels import se3 as _k
+from .rotation import Rotation
+
+__all__ = ["Transform"]
+
+
+class Transform(LieGroup):
+    """A batch of rigid motions of any shape: ``p -> R p + t``.
+
+    Stored as one array of shape ``(..., 7)``: a unit quaternion ``(w, x, y, z)``
+    (Hamilton) and a translation ``(tx, ty, tz)``. The array namespace (NumPy,
+    torch, ...) and dtype of the inputs are kept.
+
+    Parameters
+    ----------
+    rotation : Rotation, optional
+        Rotation part (identity when omitted).
+    translation : array_like, shape (..., 3), optional
+        Translation part (zero when omitted). The two batch shapes broadcast.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import rigidkit as rk
+    >>> A_R_B = rk.Rotation.from_rotvec([0.0, 0.0, np.pi / 2])
+    >>> A_T_B = rk.Transform(rotation=A_R_B, translation=[1.0, 0.0, 0.0])
+    >>> p_B = np.array([1.0, 0.0, 0.0])
+    >>> np.round(A_T_B @ p_B, 12) + 0.0
+    array([1., 1., 0.])
+    >>> B_T_A = A_T_B.inv()
+    >>> np.round(B_T_A @ (A_T_B @ p_B), 12) + 0.0
+    array([1., 0., 0.])
+    >>> np.round(rk.Transform.exp([0.0, 0.0, 1.0, 0.0, 0.0, np.pi]).as_matrix(), 12) + 0.0
+    array([[-1.,  0.,  0.,  0.],
+           [ 0., -1.,  0.,  0.],
+           [ 0.,  0.,  1.,  1.],
+           [ 0.,  0.,  0.,  1.]])
+    """
+
+    __slots__ = ("_pose",)
+    dof = 6
+    matrix_size = 4
+    point_dim = 3
+    algebra = _se3
+    __array_priority__ = 1000  # so ndarray @ Transform defers to us (and fails clearly)
+    __rmatmul_rigidkit__ = True  # Rotation @ Transform reaches our __rmatmul__
+
+    def __init__(self, rotation=None, translation=None):
+        if rotation is not None and not isinstance(rotation, Rotation):
+            raise TypeError(
+                f"rotation must be a rigidkit.Rotation, got {type(rotation).__name__}"
+            )
+        if translation is not None:
+            translation = as_array(translation, (3,), "translation")
+            check_finite(translation, (3,), "translation")
+        if rotation is None and translation is None:
+            self._pose = _identity_pose((), np.float64)
+            return
+        if rotation is None:
+            quat = _constant_like(translation, [1.0, 0.0, 0.0, 0.0])
+        else:
+            quat = rotation._quat
+        if translation is None:
+            translation = _constant_like(quat, [0.0, 0.0, 0.0])
+        self._pose = _k.pose_from_quat_translation(quat, translation)
+
+    # -- construction ------------------------------------------------------------------
+    @classmethod
+    def _wrap(cls, pose):
+        obj = cls.__new__(cls)
+        obj._pose = pose
+        return obj
+
+    @classmethod
+    def from_matrix(cls, matrix, *, atol=None, orthonormalize=False):
+        """From homogeneous matrices ``[[R, t], [0, 1]]``, shape (..., 4, 4), validated.
+
+        Raises :class:`~rigidkit.NotARotationError` (naming the batch index) when the
+        bottom row is not ``[0, 0, 0, 1]`` or the rotation block is not a rotation
+        within ``atol``; ``orthonormalize=True`` replaces the rotation block by the
+        nearest rotation (SVD) instead. See :func:`rigidkit.se3.pose_from_matrix`.
+
+        >>> M = np.eye(4)
+        >>> M[:3, 3] = [1.0, 2.0, 3.0]
+        >>> Transform.from_matrix(M).translation
+        array([1., 2., 3.])
+        """
+        return cls._wrap(
+            _se3.pose_from_matrix(matrix, atol=atol, orthonormalize=orthonormalize)
+        )
+
+    @classmethod
+    def exp(cls, xi):
+        """``exp(hat(xi))`` of twists ``xi = (v, w)``, shape (..., 6).
+
+        ``R = exp(hat(w))`` and ``t = J_l(w) v`` (a pure translation when ``w = 0``);
+        ``w`` in radians. See :func:`rigidkit.se3.exp`.
+        """
+        return cls._wrap(_se3.pose_from_twist(xi))
+
+    @classmethod
+    def identity(cls, shape=(), *, dtype=None):
+        """Identity transforms of batch ``shape`` (``()`` for one)."""
+        shape = (shape,) if isinstance(shape, int) else tuple(shape)
+        return cls._wrap(_identity_pose(shape, dtype or np.float64))
+
+    @classmethod
+    def random(cls, shape=(), rng=None, *, dtype=None, scale=1.0):
+        """Random transforms: uniform (Haar) rotations, Gaussian translations.
+
+        Translation components are independent normal with standard deviation
+        ``scale``. ``rng`` is a :class:`numpy.random.Generator` or a seed.
+        """
+        shape = (shape,) if isinstance(shape, int) else tuple(shape)
+        rng = np.random.default_rng(rng)
+        q = _conv.quat_normalize(rng.standard_normal(shape + (4,)))
+        t = scale * rng.standard_normal(shape + (3,))
+        pose = np.concatenate([q, t], axis=-1)
+        return cls._wrap(pose.astype(dtype) if dtype is not None else pose)
+
+    @classmethod
+    def concatenate(cls, transforms):
+        """Join 1-D batches (or single transforms) along the first axis."""
+        poses = [T._pose if T._pose.ndim > 1 else T._pose[None] for T in transforms]
+        if not poses:
+            raise ShapeError("concatenate needs at least one Transform")
+        return cls._wrap(namespace_of(*poses).concat(poses, axis=0))
+
+    # -- representations ---------------------------------------------------------------
+    def as_matrix(self, *, out=None):
+        """Homogeneous matrices ``[[R, t], [0, 1]]`` (..., 4, 4), acting on ``[p; 1]``."""
+        return _k.matrix_from_pose(self._pose, out=out)
+
+    def log(self):
+        """Twists ``(v, w)``, ``|w|`` in [0, pi], shape (..., 6); inverse of :meth:`exp`.
+
+        ``w`` is the rotation vector and ``v = J_l(w)^-1 t``.
+        """
+        return _k.twist_from_pose(self._pose)
+
+    def adjoint(self):
+        """Adjoint ``[[R, hat(t) R], [0, R]]``, shape (..., 6, 6), for twists ``(v, w)``.
+
+        ``T exp(xi) T^-1 = exp(Ad xi)``.
+        """
+        return _k.adjoint_from_pose(self._pose)
+
+    @property
+    def rotation(self) -> Rotation:
+        """The rotation part ``R`` (a :class:`Rotation` of the same batch shape)."""
+        return Rotation._wrap(self._pose[..., :4])
+
+    @property
+    def translation(self):
+        """The translation part ``t``, shape (..., 3)."""
+        return self._pose[..., 4:]
+
+    # -- group operations --------------------------------------------------------------
+    def __matmul__(self, other):
+        """``T1 @ T2`` composes (``T2`` first); ``T @ p`` moves points (..., 3).
+
+        A :class:`Rotation` on either side is the transform with zero translation.
+        """
+        if isinstance(other, Transform):
+            return Transform._wrap(_k.pose_compose(self._pose, other._pose))
+        if isinstance(other, Rotation):
+            return self @ Transform(rotation=other)
+        if isinstance(other, LieGroup) or hasattr(other, "__rmatmul_rigidkit__"):
+            return NotImplemented
+        return self.apply(other)
+
+    def __rmatmul__(self, other):
+        if isinstance(other, Rotation):
+            return Transform(rotation=other) @ self
+        raise TypeError(
+            "array @ Transform is not defined; move points with T @ p or T.apply(p)"
+        )
+
+    def apply(self, points, *, out=None):
+        """Move points: ``R p + t``, shape (..., 3) broadcasting with the batch shape."""
+        return _k.pose_apply(self._pose, as_array(points, (3,), "points"), out=out)
+
+    def inv(self):
+        """Inverse transforms ``[R^T, -R^T t]`` (closed form, no matrix inverse)."""
+        return Transform._wrap(_k.pose_inv(self._pose))
+
+    def approx_equal(self, other, *, atol=1e-8):
+        """Elementwise: rotation angle between them and translation distance <= ``atol``.
+
+        ``atol`` is in radians for the rotation and in length units for the translation.
+        """
+        angle = _conv.quat_angle_between(self._pose[..., :4], other._pose[..., :4])
+        xp = namespace_of(angle)
+        d = self._pose[..., 4:] - other._pose[..., 4:]
+        dist = xp.sqrt(xp.sum(d * d, axis=-1))
+        return (angle <= atol) & (dist <= atol)
+
+    # -- container protocol ------------------------------------------------------------
+    @property
+    def shape(self) -> tuple:
+        """Batch shape (``()`` for a single transform)."""
+        return tuple(self._pose.shape[:-1])
+
+    @property
+    def dtype(self):
+        return self._pose.dtype
+
+    @property
+    def single(self) -> bool:
+        return self._pose.ndim == 1
+
+    def __len__(self):
+        if self.single:
+            raise TypeError("a single Transform has no len()")
+        return self._pose.shape[0]
+
+    def __getitem__(self, index):
+        if self.single:
+            raise TypeError("a single Transform cannot be indexed")
+        if not isinstance(index, tuple):
+            index = (index,)
+        return Transform._wrap(self._pose[index + (slice(None),)])
+
+    def __iter__(self):
+        if self.single:
+            raise TypeError("a single Transform is not iterable")
+        for k in range(len(self)):
+            yield self[k]
+
+    def reshape(self, *shape):
+        """The same transforms with another batch shape."""
+        if len(shape) == 1 and isinstance(shape[0], (tuple, list)):
+            shape = tuple(shape[0])
+        xp = namespace_of(self._pose)
+        return Transform._wrap(xp.reshape(self._pose, tuple(shape) + (7,)))
+
+    def __repr__(self):
+        if self.single:
+            p = _to_numpy(self._pose).tolist()
+            q = ", ".join(f"{c:.6g}" for c in p[:4])
+            t = ", ".join(f"{c:.6g}" for c in p[4:])
+            return f"Transform(rotation=Rotation.from_quat([{q}]), translation=[{t}])"
+        return f"Transform(shape={self.shape}, dtype={self._pose.dtype})"
+
+    def __reduce__(self):
+        return (Transform._wrap, (self._pose,))
+
+    def __eq__(self, other):  # identity of objects; use approx_equal for transforms
+        return NotImplemented if not isinstance(other, Transform) else self is other
+
+    __hash__ = object.__hash__
+
+
+def _identity_pose(shape, dtype):
+    pose = np.zeros(tuple(shape) + (7,), dtype=dtype)
+    pose[..., 0] = 1.0
+    return pose
+
+
+def _constant_like(a, values):
+    """``values`` as an array of the namespace, dtype and device of ``a``."""
+    xp = namespace_of(a)
+    return xp.asarray(values, dtype=a.dtype, device=device_of(a))
