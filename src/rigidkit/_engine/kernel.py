@@ -24,7 +24,6 @@ Dispatch, for ``a = kernel(arrays...)``:
 
 from __future__ import annotations
 
-import ast
 import builtins
 import math
 import os
@@ -102,33 +101,41 @@ class _Rebindable:
         return make(self.fn, env)
 
 
-class _InlineBranches(ast.NodeTransformer):
-    """``where(c, a, b)`` -> ``(a if c else b)``; ``maximum``/``minimum`` likewise."""
+def _inline_branches():
+    """A transformer: ``where(c, a, b)`` -> ``(a if c else b)``; max/min likewise."""
+    import ast
 
-    def visit_Call(self, node):
-        self.generic_visit(node)
-        if isinstance(node.func, ast.Name) and not node.keywords:
-            name, args = node.func.id, node.args
-            if name == "where" and len(args) == 3:
-                return ast.IfExp(test=args[0], body=args[1], orelse=args[2])
-            if name in ("maximum", "minimum") and len(args) == 2:
-                op = ast.GtE() if name == "maximum" else ast.LtE()
-                a, b = args
-                if isinstance(a, ast.Name) and isinstance(b, ast.Name):
-                    test = ast.Compare(left=a, ops=[op], comparators=[b])
-                    return ast.IfExp(test=test, body=a, orelse=b)
-        return node
+    class InlineBranches(ast.NodeTransformer):
+        """``where(c, a, b)`` -> ``(a if c else b)``; ``maximum``/``minimum`` likewise."""
+
+        def visit_Call(self, node):
+            self.generic_visit(node)
+            if isinstance(node.func, ast.Name) and not node.keywords:
+                name, args = node.func.id, node.args
+                if name == "where" and len(args) == 3:
+                    return ast.IfExp(test=args[0], body=args[1], orelse=args[2])
+                if name in ("maximum", "minimum") and len(args) == 2:
+                    op = ast.GtE() if name == "maximum" else ast.LtE()
+                    a, b = args
+                    if isinstance(a, ast.Name) and isinstance(b, ast.Name):
+                        test = ast.Compare(left=a, ops=[op], comparators=[b])
+                        return ast.IfExp(test=test, body=a, orelse=b)
+            return node
+
+    return InlineBranches()
 
 
 def _scalar_version(fn, env: dict):
     """``fn`` compiled with branches inlined for Python floats (falls back to ``fn``)."""
+    import ast  # only when a kernel is first evaluated on Python floats
+
     try:
         from .numba_backend import function_source
 
         tree = ast.parse(function_source(fn))
     except (OSError, TypeError):  # no source (defined interactively): plain rebind
         return _rebind(fn, env)
-    tree = ast.fix_missing_locations(_InlineBranches().visit(tree))
+    tree = ast.fix_missing_locations(_inline_branches().visit(tree))
     namespace = dict(env)
     exec(compile(tree, f"<rigidkit scalar {fn.__name__}>", "exec"), namespace)
     return namespace[fn.__name__]

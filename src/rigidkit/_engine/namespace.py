@@ -76,7 +76,9 @@ def _torch_namespace():
             ones_like=torch.ones_like,
             zeros_like=torch.zeros_like,
             linalg=torch.linalg,
-            max=lambda x, axis=None: torch.amax(x) if axis is None else torch.amax(x, dim=axis),
+            max=lambda x, axis=None: (
+                torch.amax(x) if axis is None else torch.amax(x, dim=axis)
+            ),
             matmul=torch.matmul,
         )
         _TORCH_NS = ns

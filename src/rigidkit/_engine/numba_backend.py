@@ -12,15 +12,9 @@ the parallel path.
 
 from __future__ import annotations
 
-import hashlib
-import importlib.util
-import inspect
 import os
 import sys
-import tempfile
-import textwrap
 import threading
-from concurrent.futures import ThreadPoolExecutor
 
 from .primitives import NUMBA_PRELUDE
 
@@ -64,6 +58,9 @@ def _cache_dir() -> str | None:
 
 def function_source(fn) -> str:
     """Source of ``fn`` without decorators, dedented."""
+    import inspect  # these imports cost ~20 ms, paid only when a kernel is compiled
+    import textwrap
+
     src = textwrap.dedent(inspect.getsource(fn))
     lines = src.splitlines()
     start = next(i for i, line in enumerate(lines) if line.lstrip().startswith("def "))
@@ -110,6 +107,10 @@ def module_source(kernel) -> str:
 
 def compile_loop(kernel):
     """Import (and so compile on first call) the generated module of ``kernel``."""
+    import hashlib
+    import importlib.util
+    import tempfile
+
     import numba
 
     src = module_source(kernel)
@@ -139,6 +140,8 @@ def compile_loop(kernel):
 def _pool():
     global _POOL
     if _POOL is None:
+        from concurrent.futures import ThreadPoolExecutor
+
         _POOL = ThreadPoolExecutor(max_workers=max(1, _ncpu()))
     return _POOL
 
