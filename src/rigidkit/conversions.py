@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-from ._engine.namespace import is_numpy, namespace_of
+from ._engine.namespace import is_float32, is_numpy, namespace_of
 from ._validate import as_array, batch_index, check_finite, where_text
 from .errors import NotARotationError, ZeroNormError
 from .kernels import axis_angle as _aa
@@ -72,7 +72,11 @@ def quat_normalize(q, *, what="quaternion"):
         For NaN/inf components or a zero quaternion, naming the batch index.
     """
     q = as_array(q, (4,), what)
-    unit, norm = _q.quat_normalize(q)
+    if type(q) is np.ndarray and q.ndim == 1:  # one element: Python floats, no warnings
+        unit, norm = _q.quat_normalize(q)
+    else:
+        with _quiet():
+            unit, norm = _q.quat_normalize(q)
     # One test on the kernel's norm output catches zero, NaN and inf inputs alike
     # (NaN fails every comparison), so valid input costs no separate pass.
     ok = (norm > 0.0) & (norm < math.inf)
@@ -83,6 +87,15 @@ def quat_normalize(q, *, what="quaternion"):
             "it names no rotation"
         )
     return unit
+
+
+def _quiet():
+    """Silence NumPy's NaN/inf warnings around a kernel whose outputs are checked.
+
+    Invalid input (NaN, inf, zero) is detected from a kernel's outputs, after it
+    ran; the element-wise NumPy path would first warn about the NaN it computes.
+    """
+    return np.errstate(invalid="ignore", divide="ignore", over="ignore")
 
 
 def _all(mask) -> bool:
@@ -111,8 +124,7 @@ def quat_xyzw_from_wxyz(q):
 
 def default_atol(dtype) -> float:
     """Tolerance of :func:`quat_from_matrix`: 1e-6 for float64, 1e-4 for float32."""
-    # str() works for every namespace's dtype (numpy, torch, array-api-strict).
-    return 1e-4 if str(dtype).endswith("float32") else 1e-6
+    return 1e-4 if is_float32(dtype) else 1e-6
 
 
 def quat_from_matrix(matrix, *, atol=None, orthonormalize=False):
@@ -140,7 +152,11 @@ def quat_from_matrix(matrix, *, atol=None, orthonormalize=False):
     if orthonormalize:
         check_finite(m, (3, 3), "rotation matrix")  # before the SVD, which hangs on inf
         m = nearest_rotation_matrix(m)
-    q, err = _mat.quat_from_matrix(m)
+    if type(m) is np.ndarray and m.ndim == 2:
+        q, err = _mat.quat_from_matrix(m)
+    else:
+        with _quiet():
+            q, err = _mat.quat_from_matrix(m)
     tol = default_atol(getattr(q, "dtype", None)) if atol is None else atol
     # NaN fails every comparison, so non-finite input is caught here too.
     ok = err <= tol
@@ -163,7 +179,7 @@ def _why(m, idx) -> str:
         return f"det = {det:.6g} < 0 (a reflection)"
     sv = np.linalg.svd(a, compute_uv=False)
     if np.abs(sv - sv.mean()).max() < 1e-3 * max(sv.max(), 1e-300):
-        return f"it scales by {sv.mean():.6g} (|R^T R - I| = {dev:.3g})"
+        return f"it scales by {sv.mean():.9g} (|R^T R - I| = {dev:.3g})"
     return f"|R^T R - I| = {dev:.3g}, singular values {np.round(sv, 6).tolist()}"
 
 

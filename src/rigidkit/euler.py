@@ -50,7 +50,7 @@ from typing import NamedTuple
 import numpy as np
 
 from . import conversions as _conv
-from ._engine.namespace import namespace_of
+from ._engine.namespace import is_float32, namespace_of
 from ._validate import as_array, batch_index, check_finite, where_text
 from .errors import EulerSequenceError, GimbalLockWarning
 from .kernels import euler as _k
@@ -179,7 +179,7 @@ _THRESHOLDS: dict = {}
 
 def _eps(dtype) -> float:
     """Machine epsilon of a float dtype of any namespace (float32, else float64)."""
-    return 1.1920928955078125e-07 if "float32" in str(dtype) else 2.220446049250313e-16
+    return 1.1920928955078125e-07 if is_float32(dtype) else 2.220446049250313e-16
 
 
 def _dtype(a):

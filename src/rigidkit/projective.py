@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._engine.namespace import device_of, namespace_of
+from ._engine.namespace import device_of, is_float32, namespace_of
 from ._validate import _to_numpy, as_array, batch_index, check_finite, where_text
 from .errors import PointAtInfinityError, SingularMatrixError
 from .kernels import homogeneous as _k
@@ -136,7 +136,7 @@ def singular_rtol(dtype) -> float:
     (float64) or 1e-5 (float32) an inverse keeps fewer than about 4 (resp. 2)
     correct digits, so we refuse it.
     """
-    return 1e-5 if "32" in str(dtype) else 1e-12
+    return 1e-5 if is_float32(dtype) else 1e-12
 
 
 def infinity_rtol(dtype) -> float:
@@ -145,7 +145,7 @@ def infinity_rtol(dtype) -> float:
     64 eps of the dtype: ``w`` is then within a few dozen roundings of zero, so
     its sign, and the side of infinity the point lies on, are noise.
     """
-    return _INF_RTOL_32 if "32" in str(dtype) else _INF_RTOL_64
+    return _INF_RTOL_32 if is_float32(dtype) else _INF_RTOL_64
 
 
 _INF_RTOL_32 = 64.0 * float(np.finfo(np.float32).eps)

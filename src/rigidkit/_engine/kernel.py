@@ -217,13 +217,13 @@ class Kernel(_Rebindable):
         backend : {"numba", "xp", "python"}, optional
             Force a binding (tests use this to compare them).
         """
-        if backend is None and out is None:
+        if backend is None:
             if self.params:
                 single = self._single(args[: len(self.params)], args[len(self.params) :])
             else:
                 single = self._single((), args)
             if single is not None:
-                return single
+                return single if out is None else self._write_out(single, out)
         nparams = len(self.params)
         params = args[:nparams]
         arrays = args[nparams:]
@@ -309,7 +309,8 @@ class Kernel(_Rebindable):
             elif (n > NUMBA_MIN or dtype in self._warm) and numba_backend.available():
                 backend = "numba"
             else:
-                return self._call_xp(np, params, arrays, batch)
+                res = self._call_xp(np, params, arrays, batch)
+                return res if out is None else self._write_out(res, out)
         if backend == "python":
             return self._call_python(params, arrays, batch, dtype, out)
         if backend == "numba":
@@ -330,6 +331,16 @@ class Kernel(_Rebindable):
                 )
         return outs
 
+    def _write_out(self, res, out):
+        """Copy results into the caller's ``out=`` buffers and return those."""
+        res = [res] if len(self.outputs) == 1 else list(res)
+        outs = self._outputs(
+            tuple(np.shape(res[0]))[: np.ndim(res[0]) - len(self.outputs[0])], None, out
+        )
+        for o, r in zip(outs, res):
+            o[...] = r
+        return self._finish(outs)
+
     def _finish(self, outs):
         return outs[0] if len(outs) == 1 else tuple(outs)
 
@@ -347,29 +358,36 @@ class Kernel(_Rebindable):
         return self._finish(outs)
 
     def _call_numba(self, params, arrays, batch, dtype, out, n):
-        if self._loop is None:
-            self._loop = numba_backend.compile_loop(self)
         outs = self._outputs(batch, dtype, out)
-        args = list(params)
+        flat_max = numba_backend.FLAT_MAX
+        ins = []
+        bcast = []
         for a, trail in zip(arrays, self.inputs):
             m = math.prod(trail)
             size = a.size // m if m else 0
-            if size == n:
-                flat = np.ascontiguousarray(a, dtype=dtype).reshape(n, m)
-                step = 1
-            elif size == 1:
-                flat = np.ascontiguousarray(a, dtype=dtype).reshape(1, m)
-                step = 0
-            else:
-                flat = np.ascontiguousarray(
-                    np.broadcast_to(a, batch + trail), dtype=dtype
-                ).reshape(n, m)
-                step = 1
-            args += [flat, step]
+            if size == 1 and n != 1:  # one row for the whole batch: read it once
+                ins.append((np.ascontiguousarray(a, dtype=dtype).reshape(m), None))
+                bcast.append(True)
+                continue
+            if size != n:
+                a = np.broadcast_to(a, batch + trail)
+            flat = np.ascontiguousarray(a, dtype=dtype)
+            ins.append(
+                (flat.reshape(n * m), m) if m <= flat_max else (flat.reshape(n, m), 0)
+            )
+            bcast.append(False)
+        key = tuple(bcast)
+        if self._loop is None:
+            self._loop = {}
+        loop = self._loop.get(key)
+        if loop is None:
+            loop = self._loop[key] = numba_backend.compile_loop(self, key)
+        oargs = []
         for o, s in zip(outs, self.outputs):
-            args.append(o.reshape(n, math.prod(s)))
+            m = math.prod(s)
+            oargs.append((o.reshape(n * m), m) if m <= flat_max else (o.reshape(n, m), 0))
         if n:
-            numba_backend.run_loop(self._loop, n, args)
+            numba_backend.run_loop(loop, n, list(params), ins, oargs)
             self._warm.add(dtype)
         return self._finish(outs)
 

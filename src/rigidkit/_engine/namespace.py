@@ -136,3 +136,19 @@ def float_dtype_of(xp, *arrays):
     if dts and all(d == f32 for d in dts):
         return f32
     return f64
+
+
+_NP_F64 = np.dtype(np.float64)
+_NP_F32 = np.dtype(np.float32)
+
+
+def is_float32(dtype) -> bool:
+    """True for a 32-bit float dtype of any namespace (NumPy, torch, array-api).
+
+    Identity tests first: ``str(dtype)`` costs ~1 us, a lot on one element.
+    """
+    if dtype is _NP_F64:
+        return False
+    if dtype is _NP_F32:
+        return True
+    return str(dtype).endswith("float32")

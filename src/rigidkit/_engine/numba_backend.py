@@ -67,26 +67,43 @@ def function_source(fn) -> str:
     return "\n".join(lines[start:]) + "\n"
 
 
-def _loop_source(kernel) -> str:
+#: Rows at most this wide are read and written through flat 1-D views with a
+#: constant stride (``a[4 * i + c]``), which LLVM vectorises; wider rows (3x3
+#: matrices) stay 2-D (``a[i, c]``): a stride-9 interleaved store vectorises badly.
+FLAT_MAX = 4
+
+
+def _loop_source(kernel, bcast=()) -> str:
+    """Loop over ``range(n)`` (a known non-negative index: LLVM vectorises it).
+
+    Inputs flagged in ``bcast`` are a single row, read once before the loop.
+    """
     nparams = len(kernel.params)
-    args = ["start", "stop"]
-    args += [f"p{k}" for k in range(nparams)]
-    body = []
+    args = ["n"] + [f"p{k}" for k in range(nparams)]
+    pre = []
     call = [f"p{k}" for k in range(nparams)]
     for k, shape in enumerate(kernel.inputs):
-        args += [f"a{k}", f"s{k}"]
-        body.append(f"        j{k} = i * s{k}")
-        call += [f"a{k}[j{k}, {c}]" for c in range(_size(shape))]
-    outs = []
+        args.append(f"a{k}")
+        w = _size(shape)
+        if k < len(bcast) and bcast[k]:
+            pre += [f"    b{k}_{c} = a{k}[{c}]" for c in range(w)]
+            call += [f"b{k}_{c}" for c in range(w)]
+        elif w <= FLAT_MAX:
+            call += [f"a{k}[{w} * i + {c}]" for c in range(w)]
+        else:
+            call += [f"a{k}[i, {c}]" for c in range(w)]
+    body = [f"        r = {kernel.name}({', '.join(call)})"]
+    j = 0
     for k, shape in enumerate(kernel.outputs):
         args.append(f"o{k}")
-        outs += [(k, c) for c in range(_size(shape))]
-    body.append(f"        r = {kernel.name}({', '.join(call)})")
-    for n, (k, c) in enumerate(outs):
-        body.append(f"        o{k}[i, {c}] = r[{n}]")
+        w = _size(shape)
+        for c in range(w):
+            target = f"o{k}[{w} * i + {c}]" if w <= FLAT_MAX else f"o{k}[i, {c}]"
+            body.append(f"        {target} = r[{j}]")
+            j += 1
     head = "@numba.njit(cache=CACHE, nogil=True, error_model='numpy')\n"
     head += f"def loop({', '.join(args)}):\n"
-    return head + "    for i in range(start, stop):\n" + "\n".join(body) + "\n"
+    return head + "\n".join(pre + ["    for i in range(n):"] + body) + "\n"
 
 
 def _size(shape) -> int:
@@ -96,16 +113,37 @@ def _size(shape) -> int:
     return n
 
 
-def module_source(kernel) -> str:
+def _has_star_call(fn) -> bool:
+    """True if ``fn`` calls something with ``*args`` (numba cannot inline that)."""
+    import ast
+
+    tree = ast.parse(function_source(fn))
+    return any(
+        isinstance(node, ast.Call) and any(isinstance(x, ast.Starred) for x in node.args)
+        for node in ast.walk(tree)
+    )
+
+
+def module_source(kernel, bcast=()) -> str:
     parts = [NUMBA_PRELUDE]
-    for dep in kernel.dependencies():
-        parts.append("\n\n@numba.njit(error_model='numpy')\n" + function_source(dep.fn))
-    parts.append("\n\n@numba.njit(error_model='numpy')\n" + function_source(kernel.fn))
-    parts.append("\n\n" + _loop_source(kernel))
+    fns = [*kernel.dependencies(), kernel]
+    nargs = len(kernel.params) + sum(_size(s) for s in kernel.inputs)
+    # Inlined at numba-IR level, the kernel and its helpers fuse into the loop body
+    # (LLVM alone does not inline across numba functions). Numba's inliner cannot
+    # take calls with *args, nor very long argument lists (32: a 4x4 times a 4x4).
+    inline = nargs < 32 and not any(_has_star_call(f.fn) for f in fns)
+    deco = (
+        "@numba.njit(inline='always', error_model='numpy')"
+        if inline
+        else ("@numba.njit(error_model='numpy')")
+    )
+    for f in fns:
+        parts.append("\n\n" + deco + "\n" + function_source(f.fn))
+    parts.append("\n\n" + _loop_source(kernel, bcast))
     return "\n".join(parts)
 
 
-def compile_loop(kernel):
+def compile_loop(kernel, bcast=()):
     """Import (and so compile on first call) the generated module of ``kernel``."""
     import hashlib
     import importlib.util
@@ -113,7 +151,7 @@ def compile_loop(kernel):
 
     import numba
 
-    src = module_source(kernel)
+    src = module_source(kernel, bcast)
     digest = hashlib.sha1((src + numba.__version__).encode()).hexdigest()[:16]
     modname = f"rigidkit_k_{kernel.name}_{digest}"
     folder = _cache_dir()
@@ -171,19 +209,34 @@ def _workers() -> int:
     return max(1, min(n, int(n - others + 0.5)))
 
 
-def run_loop(loop, n, args):
-    """Run ``loop(start, stop, *args)`` over ``range(n)``, on all cores if it pays."""
-    if n < PARALLEL_MIN:
-        loop(0, n, *args)
-        return
-    workers = _workers()
+def run_loop(loop, n, params, ins, outs):
+    """Run ``loop(n, *params, *ins, *outs)``, split over threads if it pays.
+
+    ``ins``/``outs`` are ``(array, width)``: ``width`` is the row width of a flat
+    1-D array, 0 for a 2-D ``(n, width)`` array, None for a broadcast row. Each
+    thread gets views of its rows, so every loop runs over ``range(its n)``.
+    """
+
+    def chunk(start, stop):
+        args = list(params)
+        for a, w in (*ins, *outs):
+            if w is None:
+                args.append(a)
+            elif w:
+                args.append(a[w * start : w * stop])
+            else:
+                args.append(a[start:stop])
+        return args
+
+    workers = 1 if n < PARALLEL_MIN else _workers()
     if workers < 2:
-        loop(0, n, *args)
+        loop(n, *chunk(0, n))
         return
     bounds = [n * k // workers for k in range(workers + 1)]
     futures = [
-        _pool().submit(loop, bounds[k], bounds[k + 1], *args) for k in range(1, workers)
+        _pool().submit(loop, bounds[k + 1] - bounds[k], *chunk(bounds[k], bounds[k + 1]))
+        for k in range(1, workers)
     ]
-    loop(bounds[0], bounds[1], *args)
+    loop(bounds[1] - bounds[0], *chunk(bounds[0], bounds[1]))
     for f in futures:
         f.result()

@@ -143,6 +143,18 @@ def sympy_bindings() -> dict:
     def copysign(a, b):
         return sp.Abs(a) * sp.Piecewise((-1, b < 0), (1, True))
 
+    def atan2(y, x):
+        # math.atan2 and NumPy give 0 at the origin; SymPy gives nan. Kernels rely on
+        # the former in branches that where() later discards.
+        if (
+            y == 0
+            and x == 0
+            and getattr(x, "is_number", True)
+            and getattr(y, "is_number", True)
+        ):
+            return sp.Integer(0)
+        return sp.atan2(y, x)
+
     return {
         "sqrt": sp.sqrt,
         "sin": sp.sin,
@@ -151,7 +163,7 @@ def sympy_bindings() -> dict:
         "asin": sp.asin,
         "acos": sp.acos,
         "atan": sp.atan,
-        "atan2": sp.atan2,
+        "atan2": atan2,
         "exp": sp.exp,
         "log": sp.log,
         "abs": sp.Abs,

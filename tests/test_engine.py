@@ -1,0 +1,643 @@
+"""Every kernel gives the same numbers on every binding of the engine.
+
+The kernels are collected from all modules of :mod:`rigidkit.kernels`, so kernels
+added later are covered without touching this file. Each kernel is evaluated on
+2000 elements (well above the numba threshold) by
+
+* the numba loop (``backend="numba"``), the reference of the comparison;
+* the element-wise array-API evaluation with NumPy (``backend="xp"``), torch
+  (float64) and array-api-strict;
+* the Python-float function (``backend="python"`` / ``Kernel.python``) on a few
+  elements;
+* SymPy, on a few elements: the expression over ``Float`` s, and the expression
+  over symbols, evaluated afterwards node by node at 40 digits with mpmath.
+
+Also: empty and N-D batches, broadcasting, non-contiguous input, float32 kept on
+every binding, ``out=`` buffers, no JIT compile at or below 1000 elements, and
+``RIGIDKIT_DISABLE_NUMBA=1``.
+
+Tolerance: for each output of each element (a quaternion, a matrix),
+``max|a - b| <= 2e-15 * max(1, max|b|)``: relative to the output's scale, absolute
+below 1 (a component's error follows the size of the whole output, not its own:
+``x`` of ``q = e^w (cos|v|, sinc|v| v)`` carries ulps of ``e^w``). The bindings
+run the same formula, operation for operation, and differ only where their
+``sin``/``atan2``/... differ (glibc's are within ~0.5 ulp, torch's within 1 ulp),
+and at the rare input where such an ulp flips a ``where`` between a series and
+its closed form, which agree to an ulp by construction. Each binding is within
+1e-15 of the exact value (``test_conversions_accuracy.py``), so two of them are
+within 2e-15; the largest difference measured is 1.1e-15 (torch vs numba,
+``matrix_from_rotvec`` at angles near 2 pi), most are below 5e-16.
+
+Domain samplers are keyed by ``"module.kernel"`` (``PARAM_SAMPLERS`` for kernels
+with static parameters, e.g. the Euler kernels over a random one of the 24
+sequences); a kernel without one gets standard normal inputs, and is skipped
+(with the reason) if those produce NaN or inf, or if it takes static parameters.
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+import pkgutil
+import subprocess
+import sys
+import textwrap
+
+import mpmath
+import numpy as np
+import pytest
+
+import rigidkit.kernels
+from rigidkit._engine import Kernel, numba_backend
+
+# The module (the package re-exports the decorator under the same name).
+kernel_module = importlib.import_module("rigidkit._engine.kernel")
+
+torch = pytest.importorskip("torch")
+xps = pytest.importorskip("array_api_strict")
+sp = pytest.importorskip("sympy")
+
+N = 2000
+TOL = 2e-15
+
+
+# -- the registry ----------------------------------------------------------------------
+def _collect_kernels() -> dict[str, Kernel]:
+    """All Kernel objects of rigidkit.kernels.*, keyed by "module.name" of definition."""
+    found: dict[str, Kernel] = {}
+    for info in pkgutil.iter_modules(rigidkit.kernels.__path__):
+        mod = importlib.import_module(f"rigidkit.kernels.{info.name}")
+        for obj in vars(mod).values():
+            if isinstance(obj, Kernel):
+                home = obj.fn.__module__.rsplit(".", 1)[-1]
+                found[f"{home}.{obj.name}"] = obj
+    return dict(sorted(found.items()))
+
+
+KERNELS = _collect_kernels()
+
+
+# -- domain samplers -------------------------------------------------------------------
+def _unit(rng, n, d):
+    v = rng.standard_normal((n, d))
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+def _rotvecs(rng, n, span=300):
+    """Rotation vectors over all angle bands: 0, tiny, series thresholds, pi, beyond."""
+    m = max(n, 64)
+    axes = _unit(rng, m, 3)
+    angles = np.concatenate(
+        [
+            [0.0, 10.0**-span, 1e-12, 1e-8, 0.03, 0.06, 0.0599999, 0.0600001, 2.0, 4.0],
+            [math.pi, math.pi - 1e-12, math.pi + 1e-12, 2 * math.pi, 10.0],
+            10.0 ** rng.uniform(-12, 0, m // 4),
+            math.pi - 10.0 ** rng.uniform(-12, 0, m // 4),
+            rng.uniform(0, 2 * math.pi, m),
+        ]
+    )[:m]
+    return (axes * angles[:, None])[:n]
+
+
+def _quats(rng, n, span=300):
+    """Unit quaternions, both signs of w, w near 0 and exactly 0, axes and identity."""
+    special = np.array(
+        [
+            [1.0, 0, 0, 0],
+            [-1.0, 0, 0, 0],
+            [0.0, 1, 0, 0],
+            [0.0, 0, 1, 0],
+            [0.0, 0, 0, 1],
+            [0.0, 0, 0, -1],
+            [10.0**-span, 0.6, 0.8, 0],
+            [-1e-12, 0.6, 0, 0.8],
+            [1.0, 1e-12, 0, 0],
+            [1.0, 0, -(10.0**-span), 0],
+        ]
+    )
+    m = max(n, 64)
+    q = _unit(rng, m, 4)
+    q[: len(special)] = special / np.linalg.norm(special, axis=-1, keepdims=True)
+    q[len(special) : m // 4] *= 10.0 ** rng.uniform(-3, 3, (m // 4 - len(special), 1))
+    return q[:n]
+
+
+def _matrices(rng, n, span=300):
+    """Rotation matrices hitting every Shepperd branch, a few slightly perturbed."""
+    q = _quats(rng, n, span)
+    q /= np.linalg.norm(q, axis=-1, keepdims=True)
+    w, x, y, z = q.T
+    m = np.stack(
+        [
+            1 - 2 * (y * y + z * z),
+            2 * (x * y - w * z),
+            2 * (x * z + w * y),
+            2 * (x * y + w * z),
+            1 - 2 * (x * x + z * z),
+            2 * (y * z - w * x),
+            2 * (x * z - w * y),
+            2 * (y * z + w * x),
+            1 - 2 * (x * x + y * y),
+        ],
+        axis=-1,
+    ).reshape(n, 3, 3)
+    m[n // 2 :] += 1e-7 * rng.standard_normal((n - n // 2, 3, 3))  # within atol 1e-6
+    return m
+
+
+def _vectors(rng, n):
+    return rng.standard_normal((n, 3)) * 10.0 ** rng.uniform(-3, 3, (n, 1))
+
+
+SAMPLERS = {
+    "rotvec.quat_from_rotvec": lambda rng, n, span: [_rotvecs(rng, n, span)],
+    "rotvec.rotvec_from_quat": lambda rng, n, span: [_quats(rng, n, span)],
+    "rotvec.matrix_from_rotvec": lambda rng, n, span: [_rotvecs(rng, n, span)],
+    "matrix.matrix_from_quat": lambda rng, n, span: [_quats(rng, n, span)],
+    "matrix.quat_from_matrix": lambda rng, n, span: [_matrices(rng, n, span)],
+    "mrp.mrp_from_quat": lambda rng, n, span: [_quats(rng, n, span)],
+    "mrp.quat_from_mrp": lambda rng, n, span: [_rotvecs(rng, n, span) / 4.0],
+    "axis_angle.axis_angle_from_quat": lambda rng, n, span: [_quats(rng, n, span)],
+    "axis_angle.quat_from_axis_angle": lambda rng, n, span: [
+        _vectors(rng, n),
+        np.concatenate([[0.0, 1e-12, math.pi], rng.uniform(-7, 7, n)])[:n],
+    ],
+    # Any finite scale: 1e-300 ... 1e300 (1e-30 ... 1e30 in float32).
+    "quaternion.quat_normalize": lambda rng, n, span: [
+        _quats(rng, n, span) * 10.0 ** rng.uniform(-span, span, (n, 1))
+    ],
+    "quaternion.quat_multiply": lambda rng, n, span: [
+        _quats(rng, n, span),
+        _quats(rng, n, span)[::-1],
+    ],
+    "quaternion.quat_conjugate": lambda rng, n, span: [_quats(rng, n, span)],
+    "quaternion.quat_canonical": lambda rng, n, span: [
+        np.concatenate([[[0.0, 0, -0.0, -1], [0.0, -1, 0, 0]], _quats(rng, n, span)])[:n]
+    ],
+    "quaternion.quat_apply": lambda rng, n, span: [_quats(rng, n, span), _vectors(rng, n)],
+    "quaternion.quat_angle_between": lambda rng, n, span: [
+        _quats(rng, n, span),
+        _quats(rng, n, span)[::-1],
+    ],
+    "so3.hat": lambda rng, n, span: [_vectors(rng, n)],
+}
+
+
+def _euler_params(rng, with_tol):
+    """Static parameters of a random one of the 24 Euler sequences."""
+    from rigidkit import euler
+
+    seqs = [a + b + c for a in "xyz" for b in "xyz" for c in "xyz" if a != b != c]
+    seq = str(rng.choice(seqs + [s.upper() for s in seqs]))
+    params = euler.parse_sequence(seq).params + (1.0,)  # scale 1: radians
+    return params + (euler.lock_tolerance(np.float64),) if with_tol else params
+
+
+#: Samplers of kernels with static parameters: (rng, n, span) -> (params, arrays).
+PARAM_SAMPLERS = {
+    "euler.quat_from_euler": lambda rng, n, span: (
+        _euler_params(rng, False),
+        [rng.uniform(-math.pi, math.pi, (n, 3))],
+    ),
+    "euler.euler_from_quat": lambda rng, n, span: (
+        _euler_params(rng, True),
+        [_quats(rng, n, span)],
+    ),
+}
+
+
+def sample(name: str, rng, n: int, dtype=np.float64):
+    """(params, arrays) for kernel ``name``: its sampler, else standard normal."""
+    k = KERNELS[name]
+    span = 300 if dtype == np.float64 else 30  # largest decimal exponent in a sample
+    if name in PARAM_SAMPLERS:
+        params, arrays = PARAM_SAMPLERS[name](rng, n, span)
+        return params, [np.ascontiguousarray(a, dtype=dtype) for a in arrays]
+    if name in SAMPLERS:
+        arrays = SAMPLERS[name](rng, n, span)
+    else:
+        if k.params:
+            pytest.skip(f"{name} takes static parameters {k.params}; add a sampler")
+        arrays = [rng.standard_normal((n,) + s) for s in k.inputs]
+        res = _tuple(k(*arrays, backend="xp"))
+        if not all(np.isfinite(r).all() for r in res):
+            pytest.skip(
+                f"{name}: random normal inputs give NaN/inf (outside its domain) "
+                "and no sampler is registered in tests/test_engine.py"
+            )
+    return (), [np.ascontiguousarray(a, dtype=dtype) for a in arrays]
+
+
+def _tuple(res):
+    return res if isinstance(res, tuple) else (res,)
+
+
+def _np(x):
+    if isinstance(x, np.ndarray):
+        return x
+    if hasattr(x, "detach"):
+        return x.detach().cpu().numpy()
+    return np.asarray(x)
+
+
+#: Kernels whose outputs are angles: compared modulo 2 pi (pi and -pi are one angle,
+#: and rounding may land on either side of the cut).
+ANGLE_OUTPUTS = {"euler.euler_from_quat"}
+
+
+def _close(got, ref, trails, what, tol=TOL, periodic=False):
+    """Each output of each element within ``tol * max(1, max|ref|)`` of the reference.
+
+    ``trails`` are the outputs' trailing shapes (``kernel.outputs``): the scale is
+    taken over one output of one batch element (a quaternion, a matrix).
+    ``periodic``: differences are taken modulo 2 pi.
+    """
+    got, ref = _tuple(got), _tuple(ref)
+    assert len(got) == len(ref), what
+    for k, (g, r, trail) in enumerate(zip(got, ref, trails)):
+        g = np.asarray(_np(g), dtype=np.float64)
+        r = np.asarray(r, dtype=np.float64)
+        assert g.shape == r.shape, f"{what}: output {k} shape {g.shape} != {r.shape}"
+        axes = tuple(range(r.ndim - len(trail), r.ndim))
+        scale = np.maximum(
+            1.0, np.abs(r).max(axis=axes, keepdims=True) if axes else np.abs(r)
+        )
+        assert (np.isfinite(g) == np.isfinite(r)).all(), f"{what}: NaN/inf differ"
+        diff = g - r
+        if periodic:
+            diff = np.where(
+                np.isfinite(diff), np.remainder(diff + math.pi, 2 * math.pi) - math.pi, diff
+            )
+        err = np.abs(diff) / scale
+        worst = float(err.max()) if err.size else 0.0
+        if worst > tol:
+            i = np.unravel_index(np.argmax(err), err.shape)
+            raise AssertionError(
+                f"{what}, output {k}: error {worst:.3g} (relative to max(1, |output|)) "
+                f"> {tol:g} at {i}: got {g[i]!r}, want {r[i]!r}"
+            )
+
+
+def _split(flat, trails):
+    """A flat tuple of components (one element) as one array per output."""
+    out, pos = [], 0
+    for s in trails:
+        m = math.prod(s)
+        out.append(np.reshape(np.asarray(flat[pos : pos + m], dtype=np.float64), s))
+        pos += m
+    return tuple(out)
+
+
+names = pytest.mark.parametrize("name", list(KERNELS))
+
+
+# -- all bindings agree ----------------------------------------------------------------
+def _numba(k, params, arrays):
+    ref = tuple(_np(r) for r in _tuple(k(*params, *arrays, backend="numba")))
+    for r in ref:
+        assert r.dtype == np.float64 and np.isfinite(r).all(), k.name
+    return ref
+
+
+@names
+def test_array_bindings_agree(name):
+    params, arrays = sample(name, np.random.default_rng(1), N)
+    k = KERNELS[name]
+    ref = _numba(k, params, arrays)
+    outs = k.outputs
+    _close(k(*params, *arrays, backend="xp"), ref, outs, f"{name} numpy-xp vs numba")
+    tensors = [torch.from_numpy(a) for a in arrays]
+    _close(k(*params, *tensors), ref, outs, f"{name} torch vs numba")
+    strict = [xps.asarray(a) for a in arrays]
+    _close(k(*params, *strict), ref, outs, f"{name} array-api-strict vs numba")
+
+
+@names
+def test_python_floats_agree(name):
+    params, arrays = sample(name, np.random.default_rng(2), 40)
+    k = KERNELS[name]
+    ref = _numba(k, params, arrays)
+    for i in range(0, 40, 3):
+        comps = [c for a in arrays for c in np.ravel(a[i]).tolist()]
+        flat = k.python(*params, *comps)
+        assert isinstance(flat, tuple)
+        assert all(type(c) is float for c in flat), (
+            f"{name}: python binding gives non-floats"
+        )
+        want = tuple(r[i] for r in ref)
+        _close(_split(flat, k.outputs), want, k.outputs, f"{name} python floats")
+        # The array entry point on one element takes the same path.
+        one = k(*params, *[a[i] for a in arrays])
+        _close(one, want, k.outputs, f"{name} single element")
+        forced = k(*params, *[a[i : i + 1] for a in arrays], backend="python")
+        want1 = tuple(r[i : i + 1] for r in ref)
+        _close(forced, want1, k.outputs, f"{name} backend=python")
+
+
+def _sympy_float(v):
+    # The exact binary value of the float, carried at 40 digits.
+    return sp.Float(float(v), 40)
+
+
+_MP_FUNCS = {
+    "sin": mpmath.sin,
+    "cos": mpmath.cos,
+    "tan": mpmath.tan,
+    "asin": mpmath.asin,
+    "acos": mpmath.acos,
+    "atan": mpmath.atan,
+    "atan2": mpmath.atan2,
+    "exp": mpmath.exp,
+    "log": mpmath.log,
+    "Abs": mpmath.fabs,
+    "Max": max,
+    "Min": min,
+    "sign": mpmath.sign,
+}
+
+
+def _mp_eval(e, env, memo):
+    """Evaluate a SymPy expression with mpmath, sharing common subexpressions.
+
+    Kernel expressions are DAGs whose tree form can be exponentially large (a value
+    used by several later steps is copied into each), so ``subs``/``evalf`` and
+    ``lambdify`` take minutes on the larger kernels; this walk visits each distinct
+    node once. A ``Piecewise`` evaluates its conditions in order and only the
+    chosen branch, as the kernel's ``where`` means.
+    """
+    if e in memo:
+        return memo[e]
+    if e.is_Symbol:
+        v = env[e]
+    elif e is sp.true or e is sp.false:
+        v = bool(e)
+    elif e.is_Number or e is sp.pi:
+        v = mpmath.mpf(e.evalf(mpmath.mp.dps + 5))
+    elif isinstance(e, sp.Piecewise):
+        for expr, cond in e.args:
+            if _mp_eval(cond, env, memo):
+                v = _mp_eval(expr, env, memo)
+                break
+        else:
+            raise ValueError("Piecewise without a true branch")
+    elif isinstance(e, sp.ITE):
+        cond, a, b = e.args
+        v = _mp_eval(a if _mp_eval(cond, env, memo) else b, env, memo)
+    else:
+        args = [_mp_eval(a, env, memo) for a in e.args]
+        if e.is_Add:
+            v = mpmath.fsum(args)
+        elif e.is_Mul:
+            v = mpmath.fprod(args)
+        elif e.is_Pow:
+            v = args[0] ** args[1]
+        elif isinstance(e, sp.And):
+            v = all(args)
+        elif isinstance(e, sp.Or):
+            v = any(args)
+        elif isinstance(e, sp.Not):
+            v = not args[0]
+        elif isinstance(e, sp.Xor):
+            v = sum(map(bool, args)) % 2 == 1
+        elif isinstance(e, sp.core.relational.Relational):
+            v = {
+                "<": lambda a, b: a < b,
+                "<=": lambda a, b: a <= b,
+                ">": lambda a, b: a > b,
+                ">=": lambda a, b: a >= b,
+                "==": lambda a, b: a == b,
+                "!=": lambda a, b: a != b,
+            }[e.rel_op](*args)
+        else:
+            v = _MP_FUNCS[type(e).__name__](*args)
+    memo[e] = v
+    return v
+
+
+#: Known failures, each reported with a reproduction; strict, so a fix shows up.
+SYMPY_XFAIL: dict[str, str] = {}
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        pytest.param(n, marks=pytest.mark.xfail(strict=True, reason=SYMPY_XFAIL[n]))
+        if n in SYMPY_XFAIL
+        else n
+        for n in KERNELS
+    ],
+)
+def test_sympy_binding_agrees(name):
+    params, arrays = sample(name, np.random.default_rng(3), 12)
+    k = KERNELS[name]
+    ref = _numba(k, params, arrays)
+    ncomp = sum(math.prod(s) for s in k.inputs)
+    symbols = sp.symbols(f"a0:{ncomp}", real=True)
+    exprs = k.sympy(*params, *symbols)
+    assert isinstance(exprs, tuple)
+    for i in (0, 5, 11):
+        comps = [c for a in arrays for c in np.ravel(a[i]).tolist()]
+        want = tuple(r[i] for r in ref)
+        # Over Floats: every where() is decided on the spot.
+        vals = [float(e) for e in k.sympy(*params, *map(_sympy_float, comps))]
+        _close(_split(vals, k.outputs), want, k.outputs, f"{name} sympy Floats")
+        # Over symbols, the expression evaluated afterwards at 40 digits.
+        env = dict(zip(symbols, map(mpmath.mpf, comps), strict=True))
+        with mpmath.workdps(40):
+            memo: dict = {}
+            vals = [float(_mp_eval(sp.sympify(e), env, memo)) for e in exprs]
+        _close(_split(vals, k.outputs), want, k.outputs, f"{name} sympy symbols")
+
+
+# -- shapes, dtypes, buffers -----------------------------------------------------------
+def _bindings(arrays):
+    """The same arrays for each array binding: name, args, forced backend."""
+    return [
+        ("numba", arrays, "numba"),
+        ("numpy-xp", arrays, "xp"),
+        ("torch", [torch.from_numpy(np.ascontiguousarray(a)) for a in arrays], None),
+        ("strict", [xps.asarray(a) for a in arrays], None),
+    ]
+
+
+def _call(k, params, args, backend):
+    if backend is None:
+        return _tuple(k(*params, *args))
+    return _tuple(k(*params, *args, backend=backend))
+
+
+@names
+def test_empty_batch(name):
+    params, arrays = sample(name, np.random.default_rng(4), 3)
+    k = KERNELS[name]
+    empty = [a[:0] for a in arrays]
+    for label, args, backend in _bindings(empty):
+        out = _call(k, params, args, backend)
+        for r, s in zip(out, k.outputs):
+            assert tuple(r.shape) == (0,) + s, (name, label)
+
+
+@names
+def test_nd_batch(name):
+    params, arrays = sample(name, np.random.default_rng(5), 24)
+    k = KERNELS[name]
+    flat = _numba(k, params, arrays)
+    nd = [a.reshape((2, 3, 4) + a.shape[1:]) for a in arrays]
+    want = tuple(r.reshape((2, 3, 4) + r.shape[1:]) for r in flat)
+    for label, args, backend in _bindings(nd):
+        _close(_call(k, params, args, backend), want, k.outputs, f"{name} N-D on {label}")
+    # A non-contiguous input (a transposed batch) gives the same numbers.
+    nd_t = [np.swapaxes(a, 0, 1) for a in nd]
+    want_t = tuple(np.swapaxes(r, 0, 1) for r in want)
+    _close(_call(k, params, nd_t, "numba"), want_t, k.outputs, f"{name} non-contiguous")
+
+
+MULTI = [n for n, k in KERNELS.items() if len(k.inputs) >= 2]
+
+
+@pytest.mark.parametrize("name", MULTI)
+def test_broadcasting(name):
+    """Batch shapes (5, 1) and (3,) broadcast to (5, 3), like NumPy."""
+    params, arrays = sample(name, np.random.default_rng(6), 15)
+    k = KERNELS[name]
+    first = arrays[0][:5].reshape((5, 1) + arrays[0].shape[1:])
+    rest = [a[5:8] for a in arrays[1:]]
+    args = [first] + rest
+    # Reference: the Python-float function, element by element.
+    want = tuple(np.empty((5, 3) + s) for s in k.outputs)
+    for i in range(5):
+        for j in range(3):
+            elems = [first[i, 0]] + [r[j] for r in rest]
+            comps = [float(c) for a in elems for c in np.ravel(a)]
+            for w, part in zip(want, _split(k.python(*params, *comps), k.outputs)):
+                w[i, j] = part
+    for label, a, backend in _bindings(args):
+        got = _call(k, params, a, backend)
+        _close(got, want, k.outputs, f"{name} broadcast on {label}")
+
+
+@names
+def test_float32_stays_float32(name):
+    params, arrays = sample(name, np.random.default_rng(7), 64, dtype=np.float32)
+    k = KERNELS[name]
+    ref = _tuple(k(*params, *[a.astype(np.float64) for a in arrays], backend="xp"))
+    results = {
+        "numba": _call(k, params, arrays, "numba"),
+        "numpy-xp": _call(k, params, arrays, "xp"),
+        "torch": _call(k, params, [torch.from_numpy(a) for a in arrays], None),
+        "strict": _call(k, params, [xps.asarray(a) for a in arrays], None),
+        "single": _call(k, params, [a[0] for a in arrays], None),
+    }
+    want_dtype = {"torch": torch.float32, "strict": xps.float32}
+    for label, res in results.items():
+        for r in res:
+            assert r.dtype == want_dtype.get(label, np.float32), (name, label, r.dtype)
+        if name not in SAMPLERS and name not in PARAM_SAMPLERS:
+            # Random normal inputs may be ill-conditioned for the kernel (an affine
+            # inverse, say); float32 values are compared only on sampled domains.
+            continue
+        want = tuple(f[0] for f in ref) if label == "single" else ref
+        # The same formula in float32 (eps 6e-8): a few float32 ulps of the output's
+        # scale. (Accuracy proper is tested per conversion.)
+        _close(
+            res,
+            want,
+            k.outputs,
+            f"{name} float32 on {label}",
+            tol=2e-6,
+            periodic=name in ANGLE_OUTPUTS,
+        )
+
+
+@names
+def test_out_buffers(name):
+    params, arrays = sample(name, np.random.default_rng(8), 3000)
+    k = KERNELS[name]
+    ref = _numba(k, params, arrays)
+    for n, backend in [(3000, None), (3000, "numba"), (1, None), (1, "python")]:
+        outs = tuple(np.full((n,) + s, np.nan) for s in k.outputs)
+        got = k(
+            *params,
+            *[a[:n] for a in arrays],
+            out=outs if len(outs) > 1 else outs[0],
+            backend=backend,
+        )
+        for g, o in zip(_tuple(got), outs):
+            assert g is o, f"{name}: out= buffer not returned (n={n}, {backend})"
+        want = tuple(r[:n] for r in ref)
+        _close(outs, want, k.outputs, f"{name} out= (n={n}, {backend})")
+
+
+def test_out_buffer_small_cold_batch():
+    k0 = KERNELS["quaternion.quat_multiply"]
+    k = Kernel(k0.fn, k0.inputs, k0.outputs, k0.params)
+    q = _quats(np.random.default_rng(9), 10)
+    out = np.full((10, 4), np.nan)
+    got = k(q, q[::-1], out=out)
+    assert got is out
+    _close(out, k0(q, q[::-1], backend="numba"), k0.outputs, "out= small batch")
+
+
+def test_out_buffer_must_fit():
+    k = KERNELS["quaternion.quat_multiply"]
+    q = _quats(np.random.default_rng(10), 3000)
+    with pytest.raises(ValueError, match="out="):
+        k(q, q, out=np.empty((3000, 3)), backend="numba")
+
+
+# -- when the numba loop is used -------------------------------------------------------
+class _CompileCalled(Exception):
+    pass
+
+
+def test_no_jit_at_or_below_threshold(monkeypatch):
+    """A cold kernel never compiles for <= NUMBA_MIN (1000) elements, and does above."""
+    assert kernel_module.NUMBA_MIN == 1000
+    calls = []
+
+    def spy(kernel, *args):
+        calls.append(kernel.name)
+        raise _CompileCalled
+
+    monkeypatch.setattr(numba_backend, "compile_loop", spy)
+    k0 = KERNELS["rotvec.quat_from_rotvec"]
+    cold = Kernel(k0.fn, k0.inputs, k0.outputs, k0.params)
+    rng = np.random.default_rng(11)
+    for shape in [(), (2,), (1000,), (10, 100), (1, 1000)]:
+        r = rng.standard_normal(shape + (3,))
+        cold(r)
+        cold(r.astype(np.float32))
+    assert calls == []
+    with pytest.raises(_CompileCalled):
+        cold(rng.standard_normal((1001, 3)))
+    assert calls == ["quat_from_rotvec"]
+
+
+def test_disable_numba_env_var():
+    """RIGIDKIT_DISABLE_NUMBA=1: large batches run on NumPy and numba is never imported."""
+    code = textwrap.dedent(
+        """
+        import sys
+        import numpy as np
+        import rigidkit as rk
+        from rigidkit._engine import numba_backend
+        assert not numba_backend.available()
+        rng = np.random.default_rng(0)
+        q = rng.standard_normal((5000, 4))
+        R = rk.Rotation.from_quat(q)
+        m = R.as_matrix()
+        v = R.apply(np.ones((5000, 3)))
+        q = q / np.linalg.norm(q, axis=-1, keepdims=True)
+        w, x, y, z = q.T
+        assert np.allclose(m[:, 0, 1], 2 * (x * y - w * z), atol=1e-15)
+        assert np.allclose(np.einsum("nij,j->ni", m, np.ones(3)), v, atol=1e-14)
+        assert "numba" not in sys.modules, "numba was imported"
+        print("ok")
+        """
+    )
+    env = {**__import__("os").environ, "RIGIDKIT_DISABLE_NUMBA": "1"}
+    res = subprocess.run(
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120
+    )
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.strip() == "ok"
