@@ -1,0 +1,310 @@
+"""Timing helpers shared by the benchmark scripts.
+
+Nothing here imports rigidkit, so the helpers can also time it from the outside
+(import time, first call in a fresh process).
+
+How a number is taken
+---------------------
+* Every callable is called a few times before any timing (warm-up), so JIT
+  compiles (rigidkit's numba loops, quaternionic's numba ufuncs) and first-touch
+  effects are excluded from the timed samples. The cost of the compile itself is
+  reported separately, by :func:`fresh_process`.
+* A sample is ``number`` back-to-back calls with the garbage collector off, timed
+  with ``time.perf_counter``; ``number`` is calibrated so that a sample lasts at
+  least ``min_sample`` seconds (one call for a batch of a million, thousands for
+  one element).
+* The samples of all contenders of one row are taken round-robin (sample 1 of
+  every contender, then sample 2, ...), so load from other processes on a shared
+  machine hits every contender alike, and the MEDIAN of the samples is reported.
+
+The memory-bandwidth floor
+--------------------------
+:class:`StreamFloor` compiles, for a given op, a numba loop that reads exactly the
+bytes the op reads (every component of every input row) and writes exactly the
+bytes it writes (every component of every output row), doing one addition per
+component in between. No implementation of the op can move less data, so the
+time of this loop is the floor. It is measured into a preallocated output (the
+strict floor) and into a fresh ``np.empty`` output per call (what any function
+that returns a new array also pays: page faults and the kernel zeroing the new
+pages), on one core, and split in two halves over two threads (``nogil``) for
+two cores.
+"""
+
+from __future__ import annotations
+
+import gc
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+
+# -- timing ------------------------------------------------------------------------
+
+
+CLOCKS = {"wall": time.perf_counter, "thread": time.thread_time}
+_clock = time.perf_counter
+
+
+def set_clock(name: str) -> None:
+    """``"wall"`` (default) or ``"thread"`` (CPU time of the calling thread only)."""
+    global _clock
+    _clock = CLOCKS[name]
+
+
+def time_calls(fn, number: int) -> float:
+    """Seconds per call of ``fn()`` over ``number`` back-to-back calls (GC off)."""
+    clock = _clock
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        t0 = clock()
+        for _ in range(number):
+            fn()
+        t1 = clock()
+    finally:
+        if was_enabled:
+            gc.enable()
+    return (t1 - t0) / number
+
+
+def calibrate(fn, min_sample: float) -> int:
+    """Smallest number of calls, 1, 2, 5, 10, 20, ..., that lasts ``min_sample``."""
+    number = 1
+    while True:
+        for factor in (1, 2, 5):
+            n = number * factor
+            if time_calls(fn, n) * n >= min_sample:
+                return n
+        number *= 10
+
+
+def interleaved_medians(
+    fns: dict, *, repeat: int, warmup: int = 2, min_sample: float = 0.02
+) -> dict:
+    """Median seconds per call of each zero-argument callable in ``fns``.
+
+    Returns ``{name: {"median": s, "samples": [...], "number": k}}``. A callable
+    that raises during warm-up is reported as ``{"error": "..."}`` and not timed.
+    """
+    plan = {}
+    result = {}
+    for name, fn in fns.items():
+        try:
+            for _ in range(warmup):
+                fn()
+            plan[name] = (fn, calibrate(fn, min_sample))
+        except Exception as exc:  # a peer that cannot do this input: say so
+            result[name] = {"error": f"{type(exc).__name__}: {exc}"[:200]}
+    samples = {name: [] for name in plan}
+    for _ in range(repeat):
+        for name, (fn, number) in plan.items():
+            samples[name].append(time_calls(fn, number))
+    for name, (_, number) in plan.items():
+        s = samples[name]
+        result[name] = {"median": statistics.median(s), "samples": s, "number": number}
+    return result
+
+
+# -- the memory-bandwidth floor -------------------------------------------------------
+
+
+def _floor_source(in_widths, out_width) -> str:
+    args = [f"a{k}" for k in range(len(in_widths))] + ["o"]
+    terms = [f"a{k}[i, {c}]" for k, w in enumerate(in_widths) for c in range(w)]
+    # Pairwise sum: a short dependency chain, so the loop stays memory-bound.
+    while len(terms) > 1:
+        terms = [
+            f"({terms[j]} + {terms[j + 1]})" if j + 1 < len(terms) else terms[j]
+            for j in range(0, len(terms), 2)
+        ]
+    lines = [
+        "def loop(start, stop, " + ", ".join(args) + "):",
+        "    for i in range(start, stop):",
+        f"        s = {terms[0]}",
+    ]
+    lines += [f"        o[i, {c}] = s + {float(c)}" for c in range(out_width)]
+    return "\n".join(lines) + "\n"
+
+
+class StreamFloor:
+    """A numba loop that streams ``in_widths`` float64 rows in and ``out_width`` out.
+
+    ``time(n, threads, fresh_output)`` returns the callable to time; bytes per
+    element are ``8 * sum(in_widths)`` read and ``8 * out_width`` written.
+    """
+
+    _cache: dict = {}
+    _pool = None
+
+    def __init__(self, in_widths, out_width, dtype=np.float64):
+        import numba
+
+        key = (tuple(in_widths), out_width)
+        if key not in StreamFloor._cache:
+            namespace = {}
+            exec(_floor_source(in_widths, out_width), namespace)
+            StreamFloor._cache[key] = numba.njit(nogil=True, error_model="numpy")(
+                namespace["loop"]
+            )
+        self.loop = StreamFloor._cache[key]
+        self.in_widths = tuple(in_widths)
+        self.out_width = out_width
+        self.dtype = np.dtype(dtype)
+
+    @property
+    def bytes_read(self) -> int:
+        return self.dtype.itemsize * sum(self.in_widths)
+
+    @property
+    def bytes_written(self) -> int:
+        return self.dtype.itemsize * self.out_width
+
+    def callable(self, n: int, threads: int = 1, fresh_output: bool = False):
+        rng = np.random.default_rng(0)
+        ins = [rng.standard_normal((n, w)).astype(self.dtype) for w in self.in_widths]
+        out = np.empty((n, self.out_width), self.dtype)
+        out.fill(0.0)  # touch the pages once, so the preallocated case has none to fault
+        loop = self.loop
+        width = self.out_width
+        dtype = self.dtype
+        if StreamFloor._pool is None:
+            StreamFloor._pool = ThreadPoolExecutor(max_workers=4)
+        pool = StreamFloor._pool
+        bounds = [n * k // threads for k in range(threads + 1)]
+
+        def run():
+            o = np.empty((n, width), dtype) if fresh_output else out
+            if threads == 1:
+                loop(0, n, *ins, o)
+                return o
+            futs = [
+                pool.submit(loop, bounds[k], bounds[k + 1], *ins, o)
+                for k in range(1, threads)
+            ]
+            loop(bounds[0], bounds[1], *ins, o)
+            for f in futs:
+                f.result()
+            return o
+
+        return run
+
+
+def cpu_count() -> int:
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover - non-Linux
+        return os.cpu_count() or 1
+
+
+def load_average() -> str:
+    try:
+        return " ".join(f"{x:.2f}" for x in os.getloadavg())
+    except OSError:  # pragma: no cover
+        return "n/a"
+
+
+# -- fresh processes -------------------------------------------------------------------
+
+
+def run_python(code: str, env: dict | None = None, timeout: float = 600.0) -> dict:
+    """Run ``code`` in a fresh interpreter; it must print one JSON object last."""
+    full_env = dict(os.environ)
+    if env:
+        full_env.update(env)
+    proc = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        env=full_env,
+        timeout=timeout,
+    )
+    if proc.returncode != 0:
+        raise RuntimeError(f"subprocess failed:\n{proc.stderr[-2000:]}")
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+IMPORT_CODE = """
+import json, sys, time
+{pre}
+t0 = time.perf_counter()
+import {module}
+t1 = time.perf_counter()
+heavy = sorted(m for m in ("numba", "llvmlite", "scipy", "torch", "jax", "sympy")
+               if m in sys.modules)
+print(json.dumps({{"seconds": t1 - t0, "heavy": heavy}}))
+"""
+
+
+def import_times(module: str, repeat: int, preimport: str = "") -> dict:
+    """Median wall time of ``import module`` measured inside fresh interpreters.
+
+    Interpreter start-up is excluded (the clock starts just before the import),
+    and so is ``preimport`` (e.g. ``"numpy"``, to see the module's own share);
+    the first run warms the OS file cache and is discarded.
+    """
+    code = IMPORT_CODE.format(module=module, pre=f"import {preimport}" if preimport else "")
+    run_python(code)
+    runs = [run_python(code) for _ in range(repeat)]
+    secs = [r["seconds"] for r in runs]
+    return {"median": statistics.median(secs), "samples": secs, "heavy": runs[-1]["heavy"]}
+
+
+def import_profile(module: str, top: int = 6) -> list:
+    """The ``top`` modules by self time in ``python -X importtime -c 'import module'``.
+
+    Returns ``[(milliseconds, name), ...]``; one run, so only a rough guide.
+    """
+    proc = subprocess.run(
+        [sys.executable, "-X", "importtime", "-c", f"import {module}"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    rows = []
+    for line in proc.stderr.splitlines():
+        parts = line.split("|")
+        if len(parts) != 3 or not parts[0].strip().startswith("import time:"):
+            continue
+        try:
+            self_us = int(parts[0].split(":")[1])
+        except ValueError:
+            continue
+        rows.append((self_us / 1e3, parts[2].strip()))
+    return sorted(rows, reverse=True)[:top]
+
+
+# -- tables ----------------------------------------------------------------------------
+
+
+def fmt(x, digits: int = 3) -> str:
+    """A short number: 3 significant digits, no exponent for everyday values."""
+    if x is None:
+        return "-"
+    if isinstance(x, str):
+        return x
+    if x == 0:
+        return "0"
+    if abs(x) >= 10**digits:
+        return f"{x:.0f}"
+    return f"{x:.{digits}g}"
+
+
+def table(headers, rows, *, left: int = 1) -> str:
+    """Plain-text table; the first ``left`` columns are left-aligned."""
+    cells = [[str(c) for c in headers]] + [[str(c) for c in r] for r in rows]
+    widths = [max(len(r[j]) for r in cells) for j in range(len(headers))]
+
+    def line(r):
+        return "  ".join(
+            c.ljust(w) if j < left else c.rjust(w)
+            for j, (c, w) in enumerate(zip(r, widths, strict=True))
+        )
+
+    out = [line(cells[0]), "  ".join("-" * w for w in widths)]
+    out += [line(r) for r in cells[1:]]
+    return "\n".join(out)
