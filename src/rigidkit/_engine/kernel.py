@@ -101,6 +101,56 @@ class _Rebindable:
         return make(self.fn, env)
 
 
+def _single_source(kernel) -> str:
+    """Source of a kernel's one-element path: unpack, call on floats, pack.
+
+    Written out per kernel (no loops over inputs) because on one element the
+    bookkeeping costs as much as the arithmetic. It returns None unless every
+    array is a float32/float64 NumPy array of exactly its trailing shape (batch
+    shape ``()``), all of one dtype; the caller then takes the general path.
+    """
+    np_ = len(kernel.params)
+    params = [f"p{k}" for k in range(np_)]
+    names = [f"a{k}" for k in range(len(kernel.inputs))]
+    lines = [f"def single({', '.join(params + names)}):"]
+    checks = [f"type({a}) is not ndarray" for a in names]
+    checks += [f"{a}.shape != {tuple(s)!r}" for a, s in zip(names, kernel.inputs)]
+    lines.append(f"    if {' or '.join(checks)}:")
+    lines.append("        return None")
+    lines.append(f"    dt = {names[0]}.dtype")
+    same = "".join(f" or {a}.dtype is not dt" for a in names[1:])
+    lines.append(f"    if (dt is not F64 and dt is not F32){same}:")
+    lines.append("        return None")
+    call = list(params)
+    for a, s in zip(names, kernel.inputs):
+        if len(s) == 0:
+            call.append(f"{a}.item()")
+        elif len(s) == 1:
+            call.append(f"*{a}.tolist()")
+        else:
+            call.append(f"*{a}.ravel().tolist()")
+    lines.append(f"    r = py({', '.join(call)})")
+    lines.append("    flat = array(r, dt)")
+    if len(kernel.outputs) == 1:
+        s = kernel.outputs[0]
+        lines.append(
+            "    return flat" if len(s) == 1 else f"    return flat.reshape({s!r})"
+        )
+    else:
+        parts, start = [], 0
+        for s in kernel.outputs:
+            m = math.prod(s)
+            if not s:
+                parts.append(f"flat[{start}]")  # a NumPy scalar: shape ()
+            elif len(s) == 1:
+                parts.append(f"flat[{start}:{start + m}]")
+            else:
+                parts.append(f"flat[{start}:{start + m}].reshape({s!r})")
+            start += m
+        lines.append(f"    return ({', '.join(parts)},)")
+    return "\n".join(lines) + "\n"
+
+
 def _inline_branches():
     """A transformer: ``where(c, a, b)`` -> ``(a if c else b)``; max/min likewise."""
     import ast
@@ -179,15 +229,8 @@ class Kernel(_Rebindable):
         self._warm: set = set()
         self._xp_cache: dict = {}
         # One output: its shape, () when it is a flat vector (no reshape needed).
-        self._single_out = None
-        self._single_slices = []
-        start = 0
-        for shape in self.outputs:
-            self._single_slices.append((start, start + math.prod(shape), shape))
-            start += math.prod(shape)
-        if len(self.outputs) == 1:
-            shape = self.outputs[0]
-            self._single_out = "flat" if len(shape) == 1 else shape
+        self._single = None
+        self._nargs = len(self.params) + len(self.inputs)
 
     # -- scalar bindings -------------------------------------------------
     @property
@@ -217,11 +260,10 @@ class Kernel(_Rebindable):
         backend : {"numba", "xp", "python"}, optional
             Force a binding (tests use this to compare them).
         """
-        if backend is None:
-            if self.params:
-                single = self._single(args[: len(self.params)], args[len(self.params) :])
-            else:
-                single = self._single((), args)
+        if backend is None and len(args) == self._nargs:
+            if self._single is None:
+                self._single = self._make_single()
+            single = self._single(*args)
             if single is not None:
                 return single if out is None else self._write_out(single, out)
         nparams = len(self.params)
@@ -241,39 +283,17 @@ class Kernel(_Rebindable):
             return self._call_numpy(params, arrays, batch, out, backend)
         return self._call_xp(xp, params, arrays, batch)
 
-    def _single(self, params, arrays):
-        """Fast path for one element of float NumPy arrays (None if not that case)."""
-        if len(arrays) != len(self.inputs):
-            return None
-        comps = []
-        dtype = None
-        for a, trail in zip(arrays, self.inputs):
-            if type(a) is not np.ndarray or a.shape != trail:
-                return None
-            dt = a.dtype
-            if dt is not _F64 and dt is not _F32:
-                return None
-            if dtype is None:
-                dtype = dt
-            elif dt is not dtype:
-                return None
-            comps += a.ravel().tolist()
-        if dtype is None:
-            return None
-        res = self.python(*params, *comps)
-        if self._single_out is not None:
-            o = np.array(res, dtype=dtype)
-            return o if self._single_out == "flat" else o.reshape(self._single_out)
-        flat = np.array(res, dtype=dtype)
-        outs = []
-        for a, b, s in self._single_slices:
-            if not s:
-                outs.append(flat[a])  # a NumPy scalar: shape (), cheaper than 0-d
-            elif len(s) == 1:
-                outs.append(flat[a:b])
-            else:
-                outs.append(flat[a:b].reshape(s))
-        return tuple(outs)
+    def _make_single(self):
+        """Generate this kernel's one-element fast path (see :func:`_single_source`)."""
+        env = {
+            "ndarray": np.ndarray,
+            "array": np.array,
+            "F64": _F64,
+            "F32": _F32,
+            "py": self.python,
+        }
+        exec(compile(_single_source(self), f"<rigidkit single {self.name}>", "exec"), env)
+        return env["single"]
 
     def _batch_shape(self, xp, arrays):
         shapes = []

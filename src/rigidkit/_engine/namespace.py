@@ -149,6 +149,6 @@ def is_float32(dtype) -> bool:
     """
     if dtype is _NP_F64:
         return False
-    if dtype is _NP_F32:
+    if dtype is _NP_F32 or dtype is np.float32:
         return True
-    return str(dtype).endswith("float32")
+    return "float32" in str(dtype)

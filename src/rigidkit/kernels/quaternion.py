@@ -41,13 +41,28 @@ def quat_conjugate(w, x, y, z):
 
 @kernel(inputs=[(4,)], outputs=[(4,)])
 def quat_canonical(w, x, y, z):
-    """The sign of ``q`` with ``w >= 0`` (first nonzero of w, x, y, z positive)."""
-    flip = where(
-        w != 0.0,
+    """The sign of ``q`` with ``w >= 0`` (first nonzero of w, x, y, z positive).
+
+    Written with ``<`` and ``>`` only: on SymPy expressions ``==`` and ``!=`` compare
+    structure, not value.
+    """
+    s = where(
         w < 0.0,
-        where(x != 0.0, x < 0.0, where(y != 0.0, y < 0.0, z < 0.0)),
+        -1.0,
+        where(
+            w > 0.0,
+            1.0,
+            where(
+                x < 0.0,
+                -1.0,
+                where(
+                    x > 0.0,
+                    1.0,
+                    where(y < 0.0, -1.0, where(y > 0.0, 1.0, where(z < 0.0, -1.0, 1.0))),
+                ),
+            ),
+        ),
     )
-    s = where(flip, -1.0, 1.0)
     return (s * w, s * x, s * y, s * z)
 
 
