@@ -6,8 +6,7 @@ Euler UPPER = intrinsic, lower = extrinsic; twists ``(v, omega)``; radians unles
 ``degrees=True``.
 """
 
-from . import conversions, euler, quaternion, se2, se3, sim3, so2, so3
-from .affine import Affine
+from . import conversions, se3, so3
 from .errors import (
     EulerSequenceError,
     GimbalLockWarning,
@@ -21,13 +20,25 @@ from .errors import (
     SingularMatrixError,
     ZeroNormError,
 )
-from .projective import Projective
-from .quaternion import Quaternion
 from .rotation import Rotation
-from .rotation2d import Rotation2D
-from .similarity import Similarity
 from .transform import Transform
-from .transform2d import Transform2D
+
+# The rest loads on first use, which keeps ``import rigidkit`` fast (the issue's
+# budget is 150 ms with NumPy; SymPy alone would take seconds).
+_LAZY = {
+    "Rotation2D": ("rotation2d", "Rotation2D"),
+    "Transform2D": ("transform2d", "Transform2D"),
+    "Similarity": ("similarity", "Similarity"),
+    "Affine": ("affine", "Affine"),
+    "Projective": ("projective", "Projective"),
+    "Quaternion": ("quaternion", "Quaternion"),
+    "euler": ("euler", None),
+    "quaternion": ("quaternion", None),
+    "so2": ("so2", None),
+    "se2": ("se2", None),
+    "sim3": ("sim3", None),
+    "symbolic": ("symbolic", None),
+}
 
 __version__ = "0.1.0"
 
@@ -67,9 +78,16 @@ __all__ = [
 
 
 def __getattr__(name):
-    # SymPy is heavy: import the symbolic module only when it is asked for.
-    if name == "symbolic":
-        import importlib
+    if name not in _LAZY:
+        raise AttributeError(f"module 'rigidkit' has no attribute {name!r}")
+    import importlib
 
-        return importlib.import_module(".symbolic", __name__)
-    raise AttributeError(f"module 'rigidkit' has no attribute {name!r}")
+    module_name, attr = _LAZY[name]
+    module = importlib.import_module(f".{module_name}", __name__)
+    value = module if attr is None else getattr(module, attr)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY))

@@ -139,7 +139,7 @@ def affine_inverse(a00, a01, a02, t0, a10, a11, a12, t1, a20, a21, a22, t2):
     c10 = b12 * b20 - b10 * b22
     c20 = b10 * b21 - b11 * b20
     det = b00 * c00 + b01 * c10 + b02 * c20
-    d = k / where(det != 0.0, det, 1.0)
+    d = k / where(abs(det) > 0.0, det, 1.0)
     i00 = c00 * d
     i01 = (b02 * b21 - b01 * b22) * d
     i02 = (b01 * b12 - b02 * b11) * d
@@ -230,7 +230,7 @@ def projective_apply(
     w = a30 * px + a31 * py + a32 * pz + a33
     m = maximum(maximum(abs(x), abs(y)), maximum(abs(z), abs(w)))
     ratio = abs(w) / where(m > 0.0, m, 1.0)
-    safe = where(w != 0.0, w, 1.0)
+    safe = where(abs(w) > 0.0, w, 1.0)
     return (x / safe, y / safe, z / safe, ratio)
 
 
@@ -274,7 +274,7 @@ def projective_inverse(
     s0, s1, s2, s3, s4, s5, c0, c1, c2, c3, c4, c5, det = minors4(
         b00, b01, b02, b03, b10, b11, b12, b13, b20, b21, b22, b23, b30, b31, b32, b33
     )
-    d = k / where(det != 0.0, det, 1.0)
+    d = k / where(abs(det) > 0.0, det, 1.0)
     r00, r01, r02, r03 = unit_row4(a00, a01, a02, a03)
     r10, r11, r12, r13 = unit_row4(a10, a11, a12, a13)
     r20, r21, r22, r23 = unit_row4(a20, a21, a22, a23)
