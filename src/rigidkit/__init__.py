@@ -12,6 +12,7 @@ from .errors import (
     GimbalLockWarning,
     NonFiniteError,
     NotAffineError,
+    NotARigidTransformError,
     NotARotationError,
     NotASimilarityError,
     PointAtInfinityError,
@@ -65,6 +66,7 @@ __all__ = [
     # errors and warnings
     "RigidkitError",
     "NotARotationError",
+    "NotARigidTransformError",
     "NotASimilarityError",
     "NotAffineError",
     "SingularMatrixError",

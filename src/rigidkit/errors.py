@@ -9,6 +9,7 @@ from __future__ import annotations
 __all__ = [
     "RigidkitError",
     "NotARotationError",
+    "NotARigidTransformError",
     "NonFiniteError",
     "ZeroNormError",
     "ShapeError",
@@ -27,6 +28,11 @@ class RigidkitError(ValueError):
 
 class NotARotationError(RigidkitError):
     """A matrix is not in SO(3) (or SO(2)) within tolerance."""
+
+
+class NotARigidTransformError(NotARotationError):
+    """A homogeneous matrix is not in SE(3) (or SE(2)): its bottom row is not
+    ``[0, ..., 0, 1]`` or its rotation block is not a rotation."""
 
 
 class NonFiniteError(RigidkitError):

@@ -28,7 +28,7 @@ import numpy as np
 from ._engine.namespace import namespace_of
 from ._validate import as_array, batch_index, check_finite, where_text
 from .conversions import default_atol
-from .errors import NotARotationError
+from .errors import NotARigidTransformError
 from .kernels import se2 as _k
 from .so2 import check_rotation_block
 
@@ -186,7 +186,7 @@ def pose_from_matrix(matrix, *, atol=None, orthonormalize=False):
     if bool(namespace_of(bad).any(bad)):
         idx = batch_index(bad)
         row = [float(v) for v in _row(m, idx)]
-        raise NotARotationError(
+        raise NotARigidTransformError(
             f"SE(2) matrix {where_text(idx)} has bottom row {row}, "
             f"not [0, 0, 1] (tolerance {tol:g})"
         )

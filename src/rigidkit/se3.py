@@ -32,7 +32,7 @@ from __future__ import annotations
 from . import conversions as _conv
 from ._engine.namespace import namespace_of
 from ._validate import _to_numpy, as_array, batch_index, check_finite, where_text
-from .errors import NotARotationError
+from .errors import NotARigidTransformError, NotARotationError
 from .kernels import se3 as _k
 
 __all__ = [
@@ -183,14 +183,14 @@ def pose_from_matrix(M, *, atol=None, orthonormalize=False):
     if bool(xp.any(bad)):
         idx = batch_index(bad)
         row = _to_numpy(bottom)[idx].tolist()
-        raise NotARotationError(
+        raise NotARigidTransformError(
             f"homogeneous matrix {where_text(idx)} is not a rigid transform: bottom "
             f"row {row} is not [0, 0, 0, 1] (tolerance {tol:g})"
         )
     try:
         q = _conv.quat_from_matrix(M[..., :3, :3], atol=atol, orthonormalize=orthonormalize)
     except NotARotationError as err:
-        raise NotARotationError(f"rotation block of the homogeneous {err}") from None
+        raise NotARigidTransformError(f"rotation block of the homogeneous {err}") from None
     return _k.pose_from_quat_translation(q, M[..., :3, 3])
 
 
