@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._batch import BatchedArray, batch_shape
 from ._engine.namespace import device_of, namespace_of
-from ._validate import _to_numpy, as_array, batch_index, check_finite, where_text
-from .conversions import default_atol
+from ._validate import _to_numpy, as_array, check_finite
 from .errors import NotAffineError
 from .kernels import homogeneous as _k
 from .projective import (
@@ -25,11 +25,12 @@ from .projective import (
     homogeneous_matrix,
     singular_rtol,
 )
+from .se3 import check_bottom_row
 
 __all__ = ["Affine", "NotAffineError"]
 
 
-class Affine(_LadderMember):
+class Affine(BatchedArray, _LadderMember):
     """A batch of invertible affine transforms ``p -> A p + t``.
 
     Stored as one array of shape (..., 3, 4), ``[A | t]``. ``X1 @ X2`` applies ``X2``
@@ -58,6 +59,7 @@ class Affine(_LadderMember):
     """
 
     __slots__ = ("_data",)
+    _trail = (3, 4)
 
     def __init__(self, matrix=None, translation=None, *, rtol=None):
         A = (
@@ -99,12 +101,6 @@ class Affine(_LadderMember):
         self._data = data
 
     @classmethod
-    def _wrap(cls, data):
-        obj = cls.__new__(cls)
-        obj._data = data
-        return obj
-
-    @classmethod
     def from_matrix(cls, matrix, *, atol=None, rtol=None):
         """From homogeneous matrices ``[[A, t], [0, 1]]``, shape (..., 4, 4), validated.
 
@@ -139,10 +135,7 @@ class Affine(_LadderMember):
     @classmethod
     def identity(cls, shape=(), *, dtype=None):
         """Identity transforms of batch ``shape``."""
-        shape = (shape,) if isinstance(shape, int) else tuple(shape)
-        data = np.zeros(shape + (3, 4), dtype=dtype or np.float64)
-        data[..., range(3), range(3)] = 1.0
-        return cls._wrap(data)
+        return cls._wrap(cls._filled(np.eye(3, 4), shape, dtype))
 
     @classmethod
     def random(cls, shape=(), rng=None, *, dtype=None):
@@ -150,7 +143,7 @@ class Affine(_LadderMember):
 
         Invertible with probability 1; ``rng`` is a Generator or a seed.
         """
-        shape = (shape,) if isinstance(shape, int) else tuple(shape)
+        shape = batch_shape(shape)
         rng = np.random.default_rng(rng)
         A = np.eye(3) + 0.5 * rng.standard_normal(shape + (3, 3))
         t = rng.standard_normal(shape + (3,))
@@ -208,55 +201,12 @@ class Affine(_LadderMember):
         close = xp.abs(self._data - other._data) <= atol
         return xp.all(xp.reshape(close, self.shape + (12,)), axis=-1)
 
-    # -- container protocol ----------------------------------------------------------------
-    @property
-    def shape(self) -> tuple:
-        """Batch shape (``()`` for one transform)."""
-        return tuple(self._data.shape[:-2])
-
-    @property
-    def dtype(self):
-        return self._data.dtype
-
-    def __len__(self):
-        if not self.shape:
-            raise TypeError("a single Affine has no len()")
-        return self._data.shape[0]
-
-    def __getitem__(self, index):
-        if not self.shape:
-            raise TypeError("a single Affine cannot be indexed")
-        if not isinstance(index, tuple):
-            index = (index,)
-        return Affine._wrap(self._data[index + (slice(None), slice(None))])
-
-    def __repr__(self):
-        if not self.shape:
-            d = _to_numpy(self._data).tolist()
-            A = [row[:3] for row in d]
-            t = [row[3] for row in d]
-            return f"Affine(matrix={A!r}, translation={t!r})"
-        return f"Affine(shape={self.shape}, dtype={self._data.dtype})"
-
-    def __reduce__(self):
-        return (Affine._wrap, (self._data,))
-
-
-def check_bottom_row(M, atol, kind, error):
-    """Raise ``error`` where the bottom row of ``M`` (..., 4, 4) is not ``[0, 0, 0, 1]``."""
-    xp = namespace_of(M)
-    tol = default_atol(M.dtype) if atol is None else atol
-    bottom = M[..., 3, :]
-    bad = xp.any(xp.abs(bottom[..., :3]) > tol, axis=-1) | (
-        xp.abs(bottom[..., 3] - 1.0) > tol
-    )
-    if bool(xp.any(bad)):
-        idx = batch_index(bad)
-        row = _to_numpy(bottom)[idx].tolist()
-        raise error(
-            f"homogeneous matrix {where_text(idx)} is not {kind}: bottom row {row} is not "
-            f"[0, 0, 0, 1] (tolerance {tol:g})"
-        )
+    # -- container protocol (shape, len, [], reshape, ...): BatchedArray ------------------
+    def _repr_single(self):
+        d = _to_numpy(self._data).tolist()
+        A = [row[:3] for row in d]
+        t = [row[3] for row in d]
+        return f"Affine(matrix={A!r}, translation={t!r})"
 
 
 def _result_dtype(xp, a, b):

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._batch import BatchedArray, batch_shape
 from ._engine.namespace import device_of, is_float32, namespace_of
 from ._validate import _to_numpy, as_array, batch_index, check_finite, where_text
 from .errors import PointAtInfinityError, SingularMatrixError
@@ -174,7 +175,7 @@ def check_invertible(ratio, rtol, what):
 # -- the class -----------------------------------------------------------------------------
 
 
-class Projective(_LadderMember):
+class Projective(BatchedArray, _LadderMember):
     """A batch of invertible projective transforms of 3D space, one 4x4 matrix each.
 
     ``p -> (x, y, z) / w`` with ``(x, y, z, w) = H [p; 1]``; ``H`` and ``c H`` act the
@@ -207,6 +208,7 @@ class Projective(_LadderMember):
     """
 
     __slots__ = ("_data",)
+    _trail = (4, 4)
 
     def __init__(self, matrix, *, rtol=None):
         H = _as_float(as_array(matrix, (4, 4), "projective matrix"))
@@ -214,12 +216,6 @@ class Projective(_LadderMember):
         tol = singular_rtol(H.dtype) if rtol is None else rtol
         check_invertible(_k.projective_hadamard_ratio(H), tol, "projective matrix")
         self._data = H
-
-    @classmethod
-    def _wrap(cls, H):
-        obj = cls.__new__(cls)
-        obj._data = H
-        return obj
 
     @classmethod
     def from_matrix(cls, matrix, *, rtol=None):
@@ -239,10 +235,7 @@ class Projective(_LadderMember):
     @classmethod
     def identity(cls, shape=(), *, dtype=None):
         """Identity transforms of batch ``shape``."""
-        shape = (shape,) if isinstance(shape, int) else tuple(shape)
-        H = np.zeros(shape + (4, 4), dtype=dtype or np.float64)
-        H[..., range(4), range(4)] = 1.0
-        return cls._wrap(H)
+        return cls._wrap(cls._filled(np.eye(4), shape, dtype))
 
     @classmethod
     def random(cls, shape=(), rng=None, *, dtype=None):
@@ -250,9 +243,8 @@ class Projective(_LadderMember):
 
         Invertible with probability 1; ``rng`` is a Generator or a seed.
         """
-        shape = (shape,) if isinstance(shape, int) else tuple(shape)
         rng = np.random.default_rng(rng)
-        H = np.eye(4) + 0.25 * rng.standard_normal(shape + (4, 4))
+        H = np.eye(4) + 0.25 * rng.standard_normal(batch_shape(shape) + (4, 4))
         return cls(H.astype(dtype) if dtype is not None else H)
 
     # -- representations ---------------------------------------------------------------
@@ -325,35 +317,9 @@ class Projective(_LadderMember):
         flipped = xp.all(xp.reshape(xp.abs(a + b) <= atol, shape), axis=-1)
         return same | flipped
 
-    # -- container protocol ----------------------------------------------------------------
-    @property
-    def shape(self) -> tuple:
-        """Batch shape (``()`` for one transform)."""
-        return tuple(self._data.shape[:-2])
-
-    @property
-    def dtype(self):
-        return self._data.dtype
-
-    def __len__(self):
-        if not self.shape:
-            raise TypeError("a single Projective has no len()")
-        return self._data.shape[0]
-
-    def __getitem__(self, index):
-        if not self.shape:
-            raise TypeError("a single Projective cannot be indexed")
-        if not isinstance(index, tuple):
-            index = (index,)
-        return Projective._wrap(self._data[index + (slice(None), slice(None))])
-
-    def __repr__(self):
-        if not self.shape:
-            return f"Projective({_to_numpy(self._data).tolist()!r})"
-        return f"Projective(shape={self.shape}, dtype={self._data.dtype})"
-
-    def __reduce__(self):
-        return (Projective._wrap, (self._data,))
+    # -- container protocol (shape, len, [], reshape, ...): BatchedArray ------------------
+    def _repr_single(self):
+        return f"Projective({_to_numpy(self._data).tolist()!r})"
 
 
 def _as_float(a):

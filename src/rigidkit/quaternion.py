@@ -30,8 +30,9 @@ from __future__ import annotations
 import numpy as np
 
 from . import conversions as _conv
+from ._batch import BatchedArray
 from ._engine.namespace import is_numpy, namespace_of
-from ._validate import as_array, batch_index, check_finite, where_text
+from ._validate import _to_numpy, as_array, batch_index, check_finite, where_text
 from .errors import ZeroNormError
 from .kernels import quaternion as _kq
 from .kernels import quaternion_algebra as _ka
@@ -187,15 +188,7 @@ def rotate(q, points):
     return _kq.quat_apply(unit, p)
 
 
-def _numpy_of(a):
-    if isinstance(a, np.ndarray):
-        return a
-    if hasattr(a, "detach"):
-        return a.detach().cpu().numpy()
-    return np.asarray(a)
-
-
-class Quaternion:
+class Quaternion(BatchedArray):
     """A batch of general quaternions ``w + x i + y j + z k``, shape (..., 4).
 
     Hamilton convention (``ij = k``), scalar first. Operators: ``q1 + q2``,
@@ -223,6 +216,8 @@ class Quaternion:
     """
 
     __slots__ = ("_q",)
+    _storage = "_q"
+    _trail = (4,)
     # NumPy's binary operators defer to ours (ndarray * Quaternion -> __rmul__).
     __array_ufunc__ = None
 
@@ -230,12 +225,6 @@ class Quaternion:
         q = _quat(components, "quaternion components")
         check_finite(q, (4,), "quaternion components")
         self._q = q
-
-    @classmethod
-    def _wrap(cls, q):
-        obj = cls.__new__(cls)
-        obj._q = q
-        return obj
 
     @classmethod
     def from_parts(cls, scalar, vector):
@@ -307,7 +296,7 @@ class Quaternion:
         return self._q[..., 1:]
 
     def __array__(self, dtype=None, copy=None):
-        a = _numpy_of(self._q)
+        a = _to_numpy(self._q)
         if dtype is not None:
             a = a.astype(dtype, copy=False)
         return a.copy() if copy else a
@@ -419,44 +408,7 @@ class Quaternion:
         close = xp.abs(self._q - other._q) <= atol + rtol * xp.abs(other._q)
         return xp.all(close, axis=-1)
 
-    # -- container protocol ---------------------------------------------------------
-    @property
-    def shape(self) -> tuple:
-        """Batch shape (``()`` for one quaternion)."""
-        return tuple(self._q.shape[:-1])
-
-    @property
-    def dtype(self):
-        return self._q.dtype
-
-    def __len__(self):
-        if self._q.ndim == 1:
-            raise TypeError("a single Quaternion has no len()")
-        return self._q.shape[0]
-
-    def __getitem__(self, index):
-        if self._q.ndim == 1:
-            raise TypeError("a single Quaternion cannot be indexed")
-        if not isinstance(index, tuple):
-            index = (index,)
-        return Quaternion._wrap(self._q[index + (slice(None),)])
-
-    def __iter__(self):
-        if self._q.ndim == 1:
-            raise TypeError("a single Quaternion is not iterable")
-        for k in range(len(self)):
-            yield self[k]
-
-    def __repr__(self):
-        if self._q.ndim == 1:
-            vals = ", ".join(repr(float(c)) for c in _numpy_of(self._q))
-            return f"Quaternion([{vals}])"
-        return f"Quaternion(shape={self.shape}, dtype={self._q.dtype})"
-
-    def __reduce__(self):
-        return (Quaternion._wrap, (self._q,))
-
-    def __eq__(self, other):  # object identity; compare values with approx_equal
-        return NotImplemented if not isinstance(other, Quaternion) else self is other
-
-    __hash__ = object.__hash__
+    # -- container protocol (shape, len, [], reshape, ...): BatchedArray ------------------
+    def _repr_single(self):
+        vals = ", ".join(repr(c) for c in _to_numpy(self._q).tolist())
+        return f"Quaternion([{vals}])"

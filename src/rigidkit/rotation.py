@@ -13,19 +13,15 @@ import math
 import numpy as np
 
 from . import conversions as _conv
-from ._engine.namespace import is_numpy, namespace_of
-from ._validate import as_array
-from .errors import ShapeError
+from . import euler
+from ._batch import BatchedArray, batch_shape
+from ._validate import _to_numpy, as_array
 from .group import LieGroup
 
 __all__ = ["Rotation"]
 
 
-def _numpy_or(x):
-    return np.asarray(x) if is_numpy(namespace_of(x)) else x
-
-
-class Rotation(LieGroup):
+class Rotation(BatchedArray, LieGroup):
     """A batch of 3D rotations of any shape, one unit quaternion each.
 
     Conventions: Hamilton quaternions ``(w, x, y, z)``; active rotations on column
@@ -45,6 +41,8 @@ class Rotation(LieGroup):
     """
 
     __slots__ = ("_quat",)
+    _storage = "_quat"
+    _trail = (4,)
     dof = 3
     matrix_size = 3
     point_dim = 3
@@ -56,12 +54,6 @@ class Rotation(LieGroup):
         self._quat = quat
 
     # -- construction -------------------------------------------------------
-    @classmethod
-    def _wrap(cls, quat):
-        obj = cls.__new__(cls)
-        obj._quat = quat
-        return obj
-
     @classmethod
     def from_quat(cls, quat, *, scalar_first=True):
         """From quaternions, shape (..., 4); normalised (any finite nonzero scale).
@@ -126,17 +118,12 @@ class Rotation(LieGroup):
         >>> np.round(R.as_rotvec(), 12) + 0.0
         array([0.        , 0.        , 1.57079633])
         """
-        from . import euler
-
         return cls._wrap(euler.quat_from_euler(seq, angles, degrees=degrees))
 
     @classmethod
     def identity(cls, shape=(), *, dtype=None):
         """Identity rotations of batch ``shape`` (``()`` for one)."""
-        shape = (shape,) if isinstance(shape, int) else tuple(shape)
-        q = np.zeros(shape + (4,), dtype=dtype or np.float64)
-        q[..., 0] = 1.0
-        return cls._wrap(q)
+        return cls._wrap(cls._filled([1.0, 0.0, 0.0, 0.0], shape, dtype))
 
     @classmethod
     def random(cls, shape=(), rng=None, *, dtype=None):
@@ -144,20 +131,10 @@ class Rotation(LieGroup):
 
         ``rng`` is a :class:`numpy.random.Generator` or a seed.
         """
-        shape = (shape,) if isinstance(shape, int) else tuple(shape)
         rng = np.random.default_rng(rng)
-        q = rng.standard_normal(shape + (4,))
+        q = rng.standard_normal(batch_shape(shape) + (4,))
         q = _conv.quat_normalize(q)
         return cls._wrap(q.astype(dtype) if dtype is not None else q)
-
-    @classmethod
-    def concatenate(cls, rotations):
-        """Join 1-D batches (or single rotations) along the first axis."""
-        quats = [r._quat if r._quat.ndim > 1 else r._quat[None] for r in rotations]
-        if not quats:
-            raise ShapeError("concatenate needs at least one Rotation")
-        xp = namespace_of(*quats)
-        return cls._wrap(xp.concat(quats, axis=0))
 
     # -- representations ------------------------------------------------------
     def as_quat(self, *, scalar_first=True, canonical=False):
@@ -204,8 +181,6 @@ class Rotation(LieGroup):
         degrees: see :func:`rigidkit.euler.euler_from_quat`); the angles always
         rebuild the rotation.
         """
-        from . import euler
-
         return euler.euler_from_quat(seq, self._quat, degrees=degrees)
 
     @property
@@ -252,60 +227,7 @@ class Rotation(LieGroup):
         """Rotation angle in [0, pi] (same as :attr:`angle`)."""
         return self.angle
 
-    # -- container protocol ---------------------------------------------------------
-    @property
-    def shape(self) -> tuple:
-        """Batch shape (``()`` for a single rotation)."""
-        return tuple(self._quat.shape[:-1])
-
-    @property
-    def dtype(self):
-        return self._quat.dtype
-
-    @property
-    def single(self) -> bool:
-        return self._quat.ndim == 1
-
-    def __len__(self):
-        if self.single:
-            raise TypeError("a single Rotation has no len()")
-        return self._quat.shape[0]
-
-    def __getitem__(self, index):
-        if self.single:
-            raise TypeError("a single Rotation cannot be indexed")
-        if not isinstance(index, tuple):
-            index = (index,)
-        return Rotation._wrap(self._quat[index + (slice(None),)])
-
-    def __iter__(self):
-        if self.single:
-            raise TypeError("a single Rotation is not iterable")
-        for k in range(len(self)):
-            yield self[k]
-
-    def reshape(self, *shape):
-        """The same rotations with another batch shape."""
-        if len(shape) == 1 and isinstance(shape[0], (tuple, list)):
-            shape = tuple(shape[0])
-        xp = namespace_of(self._quat)
-        return Rotation._wrap(xp.reshape(self._quat, tuple(shape) + (4,)))
-
-    def __repr__(self):
-        q = self._quat
-        if self.single:
-            vals = ", ".join(f"{float(c):.6g}" for c in _numpy_or(_to_np(q)))
-            return f"Rotation.from_quat([{vals}])"
-        return f"Rotation(shape={self.shape}, dtype={q.dtype})"
-
-    def __reduce__(self):
-        return (Rotation._wrap, (self._quat,))
-
-    def __eq__(self, other):  # identity of objects; use approx_equal for rotations
-        return NotImplemented if not isinstance(other, Rotation) else self is other
-
-    __hash__ = object.__hash__
-
-
-def _to_np(q):
-    return q.detach().cpu().numpy() if hasattr(q, "detach") else np.asarray(q)
+    # -- container protocol (shape, len, [], reshape, ...): BatchedArray ------------------
+    def _repr_single(self):
+        vals = ", ".join(f"{c:.6g}" for c in _to_numpy(self._quat).tolist())
+        return f"Rotation.from_quat([{vals}])"

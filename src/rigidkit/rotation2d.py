@@ -14,8 +14,9 @@ import math
 import numpy as np
 
 from . import so2 as _so2
+from ._batch import BatchedArray, batch_shape
 from ._engine.namespace import is_numpy, is_torch, namespace_of
-from ._validate import as_array, check_finite
+from ._validate import _to_numpy, as_array, check_finite
 from .errors import ShapeError
 from .group import LieGroup
 from .kernels import so2 as _k
@@ -23,88 +24,7 @@ from .kernels import so2 as _k
 __all__ = ["Rotation2D"]
 
 
-def _to_np(a):
-    return a.detach().cpu().numpy() if hasattr(a, "detach") else np.asarray(a)
-
-
-def _batch_shape(shape) -> tuple:
-    return (shape,) if isinstance(shape, int) else tuple(shape)
-
-
-class _Batched:
-    """Container protocol of a class holding one array ``_data`` of shape (..., width)."""
-
-    __slots__ = ()
-    _width: int
-
-    @classmethod
-    def _wrap(cls, data):
-        obj = cls.__new__(cls)
-        obj._data = data
-        return obj
-
-    @property
-    def shape(self) -> tuple:
-        """Batch shape (``()`` for a single element)."""
-        return tuple(self._data.shape[:-1])
-
-    @property
-    def dtype(self):
-        """Floating dtype of the stored array."""
-        return self._data.dtype
-
-    @property
-    def single(self) -> bool:
-        """True for a single element (batch shape ``()``)."""
-        return self._data.ndim == 1
-
-    def __len__(self):
-        if self.single:
-            raise TypeError(f"a single {type(self).__name__} has no len()")
-        return self._data.shape[0]
-
-    def __getitem__(self, index):
-        if self.single:
-            raise TypeError(f"a single {type(self).__name__} cannot be indexed")
-        if not isinstance(index, tuple):
-            index = (index,)
-        # The trailing component axis is kept whole; an explicit ``...`` makes the
-        # index complete, as the array API requires.
-        if not any(i is Ellipsis for i in index):
-            index = index + (Ellipsis,)
-        return self._wrap(self._data[index + (slice(None),)])
-
-    def __iter__(self):
-        if self.single:
-            raise TypeError(f"a single {type(self).__name__} is not iterable")
-        for k in range(len(self)):
-            yield self[k]
-
-    def reshape(self, *shape):
-        """The same elements with another batch shape."""
-        if len(shape) == 1 and isinstance(shape[0], (tuple, list)):
-            shape = tuple(shape[0])
-        xp = namespace_of(self._data)
-        return self._wrap(xp.reshape(self._data, tuple(shape) + (self._width,)))
-
-    @classmethod
-    def concatenate(cls, items):
-        """Join 1-D batches (or single elements) along the first axis."""
-        arrays = [x._data if x._data.ndim > 1 else x._data[None] for x in items]
-        if not arrays:
-            raise ShapeError(f"concatenate needs at least one {cls.__name__}")
-        return cls._wrap(namespace_of(*arrays).concat(arrays, axis=0))
-
-    def __reduce__(self):
-        return (type(self)._wrap, (self._data,))
-
-    def __eq__(self, other):  # identity of objects; use approx_equal to compare
-        return NotImplemented if not isinstance(other, type(self)) else self is other
-
-    __hash__ = object.__hash__
-
-
-class Rotation2D(_Batched, LieGroup):
+class Rotation2D(BatchedArray, LieGroup):
     """A batch of planar rotations of any shape, one unit complex number each.
 
     Stored as ``(cos θ, sin θ)``, shape (..., 2). Rotations are active and act on
@@ -131,7 +51,7 @@ class Rotation2D(_Batched, LieGroup):
     """
 
     __slots__ = ("_data",)
-    _width = 2
+    _trail = (2,)
     dof = 1
     matrix_size = 2
     point_dim = 2
@@ -201,9 +121,7 @@ class Rotation2D(_Batched, LieGroup):
     @classmethod
     def identity(cls, shape=(), *, dtype=None):
         """Identity rotations of batch ``shape`` (``()`` for one)."""
-        z = np.zeros(_batch_shape(shape) + (2,), dtype=dtype or np.float64)
-        z[..., 0] = 1.0
-        return cls._wrap(z)
+        return cls._wrap(cls._filled([1.0, 0.0], shape, dtype))
 
     @classmethod
     def random(cls, shape=(), rng=None, *, dtype=None):
@@ -212,7 +130,7 @@ class Rotation2D(_Batched, LieGroup):
         ``rng`` is a :class:`numpy.random.Generator` or a seed.
         """
         rng = np.random.default_rng(rng)
-        t = rng.uniform(-math.pi, math.pi, _batch_shape(shape) + (1,))
+        t = rng.uniform(-math.pi, math.pi, batch_shape(shape) + (1,))
         z = _k.complex_from_angle(t)
         return cls._wrap(z.astype(dtype) if dtype is not None else z)
 
@@ -280,7 +198,6 @@ class Rotation2D(_Batched, LieGroup):
         """Elementwise: the angle between the rotations is at most ``atol`` (radians)."""
         return _k.angle_between(self._data, other._data) <= atol
 
-    def __repr__(self):
-        if self.single:
-            return f"Rotation2D.from_angle({float(_to_np(self.angle)):.6g})"
-        return f"Rotation2D(shape={self.shape}, dtype={self.dtype})"
+    # -- container protocol (shape, len, [], reshape, ...): BatchedArray ------------------
+    def _repr_single(self):
+        return f"Rotation2D.from_angle({float(_to_numpy(self.angle)):.6g})"

@@ -174,6 +174,21 @@ def pose_from_matrix(M, *, atol=None, orthonormalize=False):
     """
     M = as_array(M, (4, 4), "homogeneous matrix")
     check_finite(M, (4, 4), "homogeneous matrix")
+    check_bottom_row(M, atol, "a rigid transform", NotARigidTransformError)
+    try:
+        q = _conv.quat_from_matrix(M[..., :3, :3], atol=atol, orthonormalize=orthonormalize)
+    except NotARotationError as err:
+        raise NotARigidTransformError(f"rotation block of the homogeneous {err}") from None
+    return _k.pose_from_quat_translation(q, M[..., :3, 3])
+
+
+def check_bottom_row(M, atol, kind, error):
+    """Raise ``error`` where the bottom row of ``M`` (..., 4, 4) is not ``[0, 0, 0, 1]``.
+
+    The one bottom-row check of every 4x4 homogeneous kind (SE(3), Sim(3), affine):
+    ``kind`` names the kind in the message (``"a rigid transform"``), ``atol``
+    defaults to :func:`rigidkit.conversions.default_atol` of the dtype.
+    """
     xp = namespace_of(M)
     tol = _conv.default_atol(M.dtype) if atol is None else atol
     bottom = M[..., 3, :]
@@ -183,15 +198,10 @@ def pose_from_matrix(M, *, atol=None, orthonormalize=False):
     if bool(xp.any(bad)):
         idx = batch_index(bad)
         row = _to_numpy(bottom)[idx].tolist()
-        raise NotARigidTransformError(
-            f"homogeneous matrix {where_text(idx)} is not a rigid transform: bottom "
-            f"row {row} is not [0, 0, 0, 1] (tolerance {tol:g})"
+        raise error(
+            f"homogeneous matrix {where_text(idx)} is not {kind}: bottom row {row} is not "
+            f"[0, 0, 0, 1] (tolerance {tol:g})"
         )
-    try:
-        q = _conv.quat_from_matrix(M[..., :3, :3], atol=atol, orthonormalize=orthonormalize)
-    except NotARotationError as err:
-        raise NotARigidTransformError(f"rotation block of the homogeneous {err}") from None
-    return _k.pose_from_quat_translation(q, M[..., :3, 3])
 
 
 def adjoint(M):

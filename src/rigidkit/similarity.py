@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import conversions as _conv
+from ._batch import BatchedArray, batch_shape
 from ._engine.namespace import device_of, namespace_of
 from ._validate import _to_numpy, as_array, batch_index, check_finite, where_text
 from .errors import NotASimilarityError
@@ -25,11 +26,13 @@ from .kernels import matrix as _kmat
 from .kernels import sim3 as _k
 from .projective import _as_float, _include_check, _LadderMember, _rank
 from .rotation import Rotation
+from .se3 import check_bottom_row
+from .transform import pose_gap
 
 __all__ = ["Similarity", "NotASimilarityError"]
 
 
-class Similarity(_LadderMember, LieGroup):
+class Similarity(BatchedArray, _LadderMember, LieGroup):
     """A batch of similarity transforms ``p -> s R p + t`` (the group Sim(3)).
 
     ``S1 @ S2`` applies ``S2`` first: ``(s1 s2, R1 R2, s1 R1 t2 + t1)``; ``S @ p``
@@ -60,6 +63,7 @@ class Similarity(_LadderMember, LieGroup):
     """
 
     __slots__ = ("_data",)
+    _trail = (8,)
     dof = 7
     matrix_size = 4
     point_dim = 3
@@ -83,12 +87,6 @@ class Similarity(_LadderMember, LieGroup):
         self._data = _assemble(q, t, s)
 
     @classmethod
-    def _wrap(cls, data):
-        obj = cls.__new__(cls)
-        obj._data = data
-        return obj
-
-    @classmethod
     def from_matrix(cls, matrix, *, atol=None):
         """From homogeneous matrices ``[[s R, t], [0, 1]]``, shape (..., 4, 4), validated.
 
@@ -110,8 +108,6 @@ class Similarity(_LadderMember, LieGroup):
             positive scalar times a rotation (zero, a reflection, a non-uniform
             scaling, a shear); the message names the first batch index and why.
         """
-        from .affine import check_bottom_row
-
         M = _as_float(as_array(matrix, (4, 4), "homogeneous matrix"))
         check_finite(M, (4, 4), "homogeneous matrix")
         check_bottom_row(M, atol, "a similarity transform", NotASimilarityError)
@@ -182,11 +178,8 @@ class Similarity(_LadderMember, LieGroup):
     @classmethod
     def identity(cls, shape=(), *, dtype=None):
         """Identity transforms of batch ``shape`` (``()`` for one)."""
-        shape = (shape,) if isinstance(shape, int) else tuple(shape)
-        data = np.zeros(shape + (8,), dtype=dtype or np.float64)
-        data[..., 0] = 1.0
-        data[..., 7] = 1.0
-        return cls._wrap(data)
+        identity = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]  # (q, t, s)
+        return cls._wrap(cls._filled(identity, shape, dtype))
 
     @classmethod
     def random(cls, shape=(), rng=None, *, dtype=None):
@@ -195,7 +188,7 @@ class Similarity(_LadderMember, LieGroup):
 
         ``rng`` is a :class:`numpy.random.Generator` or a seed.
         """
-        shape = (shape,) if isinstance(shape, int) else tuple(shape)
+        shape = batch_shape(shape)
         rng = np.random.default_rng(rng)
         q = _conv.quat_normalize(rng.standard_normal(shape + (4,)))
         t = rng.standard_normal(shape + (3,))
@@ -266,53 +259,20 @@ class Similarity(_LadderMember, LieGroup):
         """Elementwise: rotation angle, translation gap and |log(s1/s2)| all <= ``atol``."""
         other = Similarity._include(other)
         a, b = self._data, other._data
-        angle = _conv.quat_angle_between(a[..., :4], b[..., :4])
+        angle, dist = pose_gap(a, b)
         xp = namespace_of(angle)
-        d = a[..., 4:7] - b[..., 4:7]
-        dist = xp.sqrt(xp.sum(d * d, axis=-1))
         dscale = xp.abs(xp.log(a[..., 7] / b[..., 7]))
         return (angle <= atol) & (dist <= atol) & (dscale <= atol)
 
-    # -- container protocol ---------------------------------------------------------------
-    @property
-    def shape(self) -> tuple:
-        """Batch shape (``()`` for one transform)."""
-        return tuple(self._data.shape[:-1])
-
-    @property
-    def dtype(self):
-        return self._data.dtype
-
-    def __len__(self):
-        if not self.shape:
-            raise TypeError("a single Similarity has no len()")
-        return self._data.shape[0]
-
-    def __getitem__(self, index):
-        if not self.shape:
-            raise TypeError("a single Similarity cannot be indexed")
-        if not isinstance(index, tuple):
-            index = (index,)
-        return Similarity._wrap(self._data[index + (slice(None),)])
-
-    def __repr__(self):
-        if not self.shape:
-            d = _to_numpy(self._data).tolist()
-            q = ", ".join(f"{c:.6g}" for c in d[:4])
-            t = ", ".join(f"{c:.6g}" for c in d[4:7])
-            return (
-                f"Similarity(scale={d[7]:.6g}, rotation=Rotation.from_quat([{q}]), "
-                f"translation=[{t}])"
-            )
-        return f"Similarity(shape={self.shape}, dtype={self._data.dtype})"
-
-    def __reduce__(self):
-        return (Similarity._wrap, (self._data,))
-
-    def __eq__(self, other):  # identity of objects; use approx_equal for values
-        return NotImplemented if not isinstance(other, Similarity) else self is other
-
-    __hash__ = object.__hash__
+    # -- container protocol (shape, len, [], reshape, ...): BatchedArray ------------------
+    def _repr_single(self):
+        d = _to_numpy(self._data).tolist()
+        q = ", ".join(f"{c:.6g}" for c in d[:4])
+        t = ", ".join(f"{c:.6g}" for c in d[4:7])
+        return (
+            f"Similarity(scale={d[7]:.6g}, rotation=Rotation.from_quat([{q}]), "
+            f"translation=[{t}])"
+        )
 
 
 def _check_positive(s):

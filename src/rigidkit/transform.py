@@ -12,9 +12,9 @@ import numpy as np
 
 from . import conversions as _conv
 from . import se3 as _se3
+from ._batch import BatchedArray, batch_shape
 from ._engine.namespace import device_of, namespace_of
 from ._validate import _to_numpy, as_array, check_finite
-from .errors import ShapeError
 from .group import LieGroup
 from .kernels import se3 as _k
 from .rotation import Rotation
@@ -22,7 +22,7 @@ from .rotation import Rotation
 __all__ = ["Transform"]
 
 
-class Transform(LieGroup):
+class Transform(BatchedArray, LieGroup):
     """A batch of rigid motions of any shape: ``p -> R p + t``.
 
     Stored as one array of shape ``(..., 7)``: a unit quaternion ``(w, x, y, z)``
@@ -56,6 +56,8 @@ class Transform(LieGroup):
     """
 
     __slots__ = ("_pose",)
+    _storage = "_pose"
+    _trail = (7,)
     dof = 6
     matrix_size = 4
     point_dim = 3
@@ -72,7 +74,7 @@ class Transform(LieGroup):
             translation = as_array(translation, (3,), "translation")
             check_finite(translation, (3,), "translation")
         if rotation is None and translation is None:
-            self._pose = _identity_pose((), np.float64)
+            self._pose = self._filled(_IDENTITY, ())
             return
         if rotation is None:
             quat = _constant_like(translation, [1.0, 0.0, 0.0, 0.0])
@@ -83,12 +85,6 @@ class Transform(LieGroup):
         self._pose = _k.pose_from_quat_translation(quat, translation)
 
     # -- construction ------------------------------------------------------------------
-    @classmethod
-    def _wrap(cls, pose):
-        obj = cls.__new__(cls)
-        obj._pose = pose
-        return obj
-
     @classmethod
     def from_matrix(cls, matrix, *, atol=None, orthonormalize=False):
         """From homogeneous matrices ``[[R, t], [0, 1]]``, shape (..., 4, 4), validated.
@@ -119,8 +115,7 @@ class Transform(LieGroup):
     @classmethod
     def identity(cls, shape=(), *, dtype=None):
         """Identity transforms of batch ``shape`` (``()`` for one)."""
-        shape = (shape,) if isinstance(shape, int) else tuple(shape)
-        return cls._wrap(_identity_pose(shape, dtype or np.float64))
+        return cls._wrap(cls._filled(_IDENTITY, shape, dtype))
 
     @classmethod
     def random(cls, shape=(), rng=None, *, dtype=None, scale=1.0):
@@ -129,20 +124,12 @@ class Transform(LieGroup):
         Translation components are independent normal with standard deviation
         ``scale``. ``rng`` is a :class:`numpy.random.Generator` or a seed.
         """
-        shape = (shape,) if isinstance(shape, int) else tuple(shape)
+        shape = batch_shape(shape)
         rng = np.random.default_rng(rng)
         q = _conv.quat_normalize(rng.standard_normal(shape + (4,)))
         t = scale * rng.standard_normal(shape + (3,))
         pose = np.concatenate([q, t], axis=-1)
         return cls._wrap(pose.astype(dtype) if dtype is not None else pose)
-
-    @classmethod
-    def concatenate(cls, transforms):
-        """Join 1-D batches (or single transforms) along the first axis."""
-        poses = [T._pose if T._pose.ndim > 1 else T._pose[None] for T in transforms]
-        if not poses:
-            raise ShapeError("concatenate needs at least one Transform")
-        return cls._wrap(namespace_of(*poses).concat(poses, axis=0))
 
     # -- representations ---------------------------------------------------------------
     def as_matrix(self, *, out=None):
@@ -207,72 +194,30 @@ class Transform(LieGroup):
 
         ``atol`` is in radians for the rotation and in length units for the translation.
         """
-        angle = _conv.quat_angle_between(self._pose[..., :4], other._pose[..., :4])
-        xp = namespace_of(angle)
-        d = self._pose[..., 4:] - other._pose[..., 4:]
-        dist = xp.sqrt(xp.sum(d * d, axis=-1))
+        angle, dist = pose_gap(self._pose, other._pose)
         return (angle <= atol) & (dist <= atol)
 
-    # -- container protocol ------------------------------------------------------------
-    @property
-    def shape(self) -> tuple:
-        """Batch shape (``()`` for a single transform)."""
-        return tuple(self._pose.shape[:-1])
-
-    @property
-    def dtype(self):
-        return self._pose.dtype
-
-    @property
-    def single(self) -> bool:
-        return self._pose.ndim == 1
-
-    def __len__(self):
-        if self.single:
-            raise TypeError("a single Transform has no len()")
-        return self._pose.shape[0]
-
-    def __getitem__(self, index):
-        if self.single:
-            raise TypeError("a single Transform cannot be indexed")
-        if not isinstance(index, tuple):
-            index = (index,)
-        return Transform._wrap(self._pose[index + (slice(None),)])
-
-    def __iter__(self):
-        if self.single:
-            raise TypeError("a single Transform is not iterable")
-        for k in range(len(self)):
-            yield self[k]
-
-    def reshape(self, *shape):
-        """The same transforms with another batch shape."""
-        if len(shape) == 1 and isinstance(shape[0], (tuple, list)):
-            shape = tuple(shape[0])
-        xp = namespace_of(self._pose)
-        return Transform._wrap(xp.reshape(self._pose, tuple(shape) + (7,)))
-
-    def __repr__(self):
-        if self.single:
-            p = _to_numpy(self._pose).tolist()
-            q = ", ".join(f"{c:.6g}" for c in p[:4])
-            t = ", ".join(f"{c:.6g}" for c in p[4:])
-            return f"Transform(rotation=Rotation.from_quat([{q}]), translation=[{t}])"
-        return f"Transform(shape={self.shape}, dtype={self._pose.dtype})"
-
-    def __reduce__(self):
-        return (Transform._wrap, (self._pose,))
-
-    def __eq__(self, other):  # identity of objects; use approx_equal for transforms
-        return NotImplemented if not isinstance(other, Transform) else self is other
-
-    __hash__ = object.__hash__
+    # -- container protocol (shape, len, [], reshape, ...): BatchedArray ------------------
+    def _repr_single(self):
+        p = _to_numpy(self._pose).tolist()
+        q = ", ".join(f"{c:.6g}" for c in p[:4])
+        t = ", ".join(f"{c:.6g}" for c in p[4:])
+        return f"Transform(rotation=Rotation.from_quat([{q}]), translation=[{t}])"
 
 
-def _identity_pose(shape, dtype):
-    pose = np.zeros(tuple(shape) + (7,), dtype=dtype)
-    pose[..., 0] = 1.0
-    return pose
+def pose_gap(a, b):
+    """Rotation angle (radians) and translation distance between poses ``a`` and ``b``.
+
+    Reads ``(w, x, y, z, tx, ty, tz)`` from the first 7 components of the last axis
+    (so also the rigid part of a similarity's ``(q, t, s)``); shapes broadcast.
+    """
+    angle = _conv.quat_angle_between(a[..., :4], b[..., :4])
+    xp = namespace_of(angle)
+    d = a[..., 4:7] - b[..., 4:7]
+    return angle, xp.sqrt(xp.sum(d * d, axis=-1))
+
+
+_IDENTITY = (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)  # (w, x, y, z, tx, ty, tz)
 
 
 def _constant_like(a, values):

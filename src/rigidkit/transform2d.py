@@ -11,16 +11,17 @@ from __future__ import annotations
 import numpy as np
 
 from . import se2 as _se2
+from ._batch import BatchedArray, batch_shape
 from ._engine.namespace import float_dtype_of, namespace_of
-from ._validate import as_array, check_finite
+from ._validate import _to_numpy, as_array, check_finite
 from .group import LieGroup
 from .kernels import se2 as _k
-from .rotation2d import Rotation2D, _batch_shape, _Batched, _to_np
+from .rotation2d import Rotation2D
 
 __all__ = ["Transform2D"]
 
 
-class Transform2D(_Batched, LieGroup):
+class Transform2D(BatchedArray, LieGroup):
     """A batch of planar rigid motions ``p -> R p + t`` of any batch shape.
 
     Parameters
@@ -53,7 +54,7 @@ class Transform2D(_Batched, LieGroup):
     """
 
     __slots__ = ("_data",)
-    _width = 4
+    _trail = (4,)
     dof = 3
     matrix_size = 3
     point_dim = 2
@@ -111,9 +112,7 @@ class Transform2D(_Batched, LieGroup):
     @classmethod
     def identity(cls, shape=(), *, dtype=None):
         """Identity motions of batch ``shape`` (``()`` for one)."""
-        pose = np.zeros(_batch_shape(shape) + (4,), dtype=dtype or np.float64)
-        pose[..., 0] = 1.0
-        return cls._wrap(pose)
+        return cls._wrap(cls._filled([1.0, 0.0, 0.0, 0.0], shape, dtype))
 
     @classmethod
     def random(cls, shape=(), rng=None, *, dtype=None):
@@ -122,7 +121,7 @@ class Transform2D(_Batched, LieGroup):
         ``rng`` is a :class:`numpy.random.Generator` or a seed.
         """
         rng = np.random.default_rng(rng)
-        shape = _batch_shape(shape)
+        shape = batch_shape(shape)
         rot = Rotation2D.random(shape, rng)
         pose = np.concatenate([rot._data, rng.standard_normal(shape + (2,))], axis=-1)
         return cls._wrap(pose.astype(dtype) if dtype is not None else pose)
@@ -186,9 +185,7 @@ class Transform2D(_Batched, LieGroup):
         angle, dist = _k.pose_distance(self._data, other._data)
         return (angle <= atol) & (dist <= atol)
 
-    def __repr__(self):
-        if self.single:
-            rot = repr(self.rotation)
-            t = ", ".join(f"{float(v):.6g}" for v in _to_np(self.translation))
-            return f"Transform2D(rotation={rot}, translation=[{t}])"
-        return f"Transform2D(shape={self.shape}, dtype={self.dtype})"
+    # -- container protocol (shape, len, [], reshape, ...): BatchedArray ------------------
+    def _repr_single(self):
+        t = ", ".join(f"{v:.6g}" for v in _to_numpy(self.translation).tolist())
+        return f"Transform2D(rotation={self.rotation!r}, translation=[{t}])"

@@ -1,0 +1,155 @@
+"""The container protocol shared by the object layer: a batch of elements in one array.
+
+Every object class of rigidkit (``Rotation``, ``Transform``, ``Quaternion``,
+``Affine``, ...) holds ONE array whose trailing axes are one element (a quaternion
+``(4,)``, a pose ``(7,)``, a matrix ``(3, 4)``, ...) and whose leading axes are the
+batch. :class:`BatchedArray` implements, once, what depends only on that layout:
+``shape``, ``dtype``, ``single``, ``len``, indexing, iteration, ``reshape``,
+``concatenate``, pickling, identity equality and the batch half of ``repr``.
+
+It is deliberately only the container surface: group operations (``@``, ``apply``,
+``inv``, ``as_matrix``) stay in each class, written against its own attribute, so a
+single-element call pays nothing for this mixin. The group interface is
+:class:`rigidkit.group.LieGroup`, a separate base.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._engine.namespace import namespace_of
+from .errors import ShapeError
+
+__all__ = ["BatchedArray", "batch_shape"]
+
+
+def batch_shape(shape) -> tuple:
+    """A batch shape argument (an int or a sequence of ints) as a tuple."""
+    return (shape,) if isinstance(shape, int) else tuple(shape)
+
+
+class BatchedArray:
+    """Mixin: a batch of elements stored in one array of shape ``batch + _trail``.
+
+    A subclass sets ``_trail`` (the trailing shape of one element) and declares the
+    slot that holds the array; when that slot is not called ``_data`` it names it in
+    ``_storage`` (``Rotation`` keeps its quaternions in ``_quat``). ``_data`` is then
+    the very same slot under a second name (the slot's descriptor is aliased, no
+    property and no copy), so ``_wrap`` and the methods below read and write it at
+    plain attribute speed. A single element has batch shape ``()``.
+
+    Subclasses implement :meth:`_repr_single`, the ``repr`` of one element.
+
+    Examples
+    --------
+    >>> import rigidkit as rk
+    >>> A_R_B = rk.Rotation.identity((2, 3))      # stored as quaternions (2, 3, 4)
+    >>> A_R_B.shape, len(A_R_B), A_R_B[1].shape, A_R_B[1, 2].shape
+    ((2, 3), 2, (3,), ())
+    >>> A_R_B.reshape(6).shape, rk.Rotation.concatenate([A_R_B[0], A_R_B[1]]).shape
+    ((6,), (6,))
+    >>> A_R_B[0, 0]
+    Rotation.from_quat([1, 0, 0, 0])
+    """
+
+    __slots__ = ()
+    _trail: tuple
+    _storage = "_data"
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if cls._storage != "_data" and cls._storage in cls.__dict__:
+            cls._data = cls.__dict__[cls._storage]
+        cls._cut = -len(cls._trail)  # shape[:_cut] is the batch shape
+        cls._whole = (slice(None),) * len(cls._trail)  # index of one whole element
+
+    @classmethod
+    def _wrap(cls, data):
+        """An instance holding ``data`` (shape ``batch + _trail``), not validated."""
+        obj = cls.__new__(cls)
+        obj._data = data
+        return obj
+
+    @classmethod
+    def _filled(cls, element, shape, dtype=None):
+        """A NumPy array of batch ``shape``, each element a copy of ``element``.
+
+        ``element`` has shape ``_trail`` (e.g. the identity); dtype default float64.
+        """
+        out = np.empty(batch_shape(shape) + cls._trail, dtype=dtype or np.float64)
+        out[...] = element
+        return out
+
+    # -- the container protocol --------------------------------------------------------
+    @property
+    def shape(self) -> tuple:
+        """Batch shape (``()`` for a single element)."""
+        return tuple(self._data.shape[: self._cut])
+
+    @property
+    def dtype(self):
+        """Floating dtype of the stored array."""
+        return self._data.dtype
+
+    @property
+    def single(self) -> bool:
+        """True for a single element (batch shape ``()``)."""
+        return self._data.ndim == len(self._trail)
+
+    def __len__(self):
+        if self.single:
+            raise TypeError(f"a single {type(self).__name__} has no len()")
+        return self._data.shape[0]
+
+    def __getitem__(self, index):
+        if self.single:
+            raise TypeError(f"a single {type(self).__name__} cannot be indexed")
+        if not isinstance(index, tuple):
+            index = (index,)
+        # The trailing element axes are kept whole; an explicit ``...`` makes the
+        # index complete, as the array API requires. (``is``, not ``in``: ``==`` on
+        # an array index would compare elementwise.)
+        for i in index:
+            if i is Ellipsis:
+                break
+        else:
+            index = index + (Ellipsis,)
+        return self._wrap(self._data[index + self._whole])
+
+    def __iter__(self):
+        if self.single:
+            raise TypeError(f"a single {type(self).__name__} is not iterable")
+        for k in range(len(self)):
+            yield self[k]
+
+    def reshape(self, *shape):
+        """The same elements with another batch shape."""
+        if len(shape) == 1 and isinstance(shape[0], (tuple, list)):
+            shape = tuple(shape[0])
+        xp = namespace_of(self._data)
+        return self._wrap(xp.reshape(self._data, tuple(shape) + self._trail))
+
+    @classmethod
+    def concatenate(cls, items):
+        """Join 1-D batches (or single elements) along the first axis."""
+        nd = len(cls._trail)
+        arrays = [x._data if x._data.ndim > nd else x._data[None] for x in items]
+        if not arrays:
+            raise ShapeError(f"concatenate needs at least one {cls.__name__}")
+        return cls._wrap(namespace_of(*arrays).concat(arrays, axis=0))
+
+    def __repr__(self):
+        if self.single:
+            return self._repr_single()
+        return f"{type(self).__name__}(shape={self.shape}, dtype={self.dtype})"
+
+    def _repr_single(self) -> str:
+        raise NotImplementedError
+
+    def __reduce__(self):
+        return (type(self)._wrap, (self._data,))
+
+    def __eq__(self, other):  # identity of objects; use approx_equal to compare values
+        return NotImplemented if not isinstance(other, type(self)) else self is other
+
+    __hash__ = object.__hash__
