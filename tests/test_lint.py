@@ -17,7 +17,9 @@ def _ruff():
     return exe
 
 
-@pytest.mark.parametrize("args", [["check"], ["format", "--check"]], ids=["check", "format"])
+@pytest.mark.parametrize(
+    "args", [["check"], ["format", "--check"]], ids=["check", "format"]
+)
 def test_ruff(args):
     paths = [str(ROOT / p) for p in ("src", "tests", "benchmarks")]
     res = subprocess.run([_ruff(), *args, *paths], capture_output=True, text=True)
