@@ -40,6 +40,7 @@ import subprocess
 import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -307,4 +308,186 @@ def table(headers, rows, *, left: int = 1) -> str:
 
     out = [line(cells[0]), "  ".join("-" * w for w in widths)]
     out += [line(r) for r in cells[1:]]
+    return "\n".join(out)
+
+
+# -- a table of ops, side by side --------------------------------------------------------
+#
+# The generic part of a "rigidkit against its peers" script: rows of ops, each with a
+# builder per contender, timed round-robin with the floor, judged against the targets
+# and printed. (bench_so3.py predates these and keeps its own copies.)
+
+
+@dataclass
+class Row:
+    """One line of the table: an op (or its ``out=`` variant) and who can do it.
+
+    ``impls`` maps a contender to ``builder(data) -> zero-argument callable`` (or
+    None where the contender lacks the op at that size); ``floor`` is ``(input
+    widths, output width)`` in float64 components per element; ``memory_bound``
+    rows must be within the floor factor of the floor.
+    """
+
+    key: str
+    floor: tuple
+    memory_bound: bool
+    kind: str  # how the result is compared with the reference
+    batched_only: bool = False
+    impls: dict = field(default_factory=dict)
+    notes: dict = field(default_factory=dict)  # contender -> footnote
+
+
+def with_threads(builder, count: int, env: str = "RIGIDKIT_NUM_THREADS"):
+    """``builder`` whose callable runs with ``env`` set to ``count`` (batches only)."""
+
+    def build(d):
+        fn = builder(d)
+        if fn is None or d.single or count > cpu_count():
+            return None
+
+        def call():
+            saved = os.environ.get(env)
+            os.environ[env] = str(count)
+            try:
+                return fn()
+            finally:
+                if saved is None:
+                    del os.environ[env]
+                else:
+                    os.environ[env] = saved
+
+        return call
+
+    return build
+
+
+FLOOR_COLUMNS = ("floor 1c", "floor 2c", "floor+alloc 1c", "floor+alloc 2c")
+
+
+def time_row(r: Row, d, contenders, *, threads, floor=True, **timing) -> dict:
+    """Medians of every contender of ``r`` (in ``contenders`` order) and of the floor.
+
+    ``d`` needs ``n`` and ``single``; ``timing`` goes to :func:`interleaved_medians`.
+    """
+    fns = {}
+    for lib in contenders:
+        if lib in r.impls:
+            fn = r.impls[lib](d)
+            if fn is not None:
+                fns[lib] = fn
+    if floor and not d.single:
+        ins, out = r.floor
+        fl = StreamFloor(ins, out)
+        for cores in threads:
+            fns[f"floor {cores}c"] = fl.callable(d.n, threads=cores)
+            fns[f"floor+alloc {cores}c"] = fl.callable(
+                d.n, threads=cores, fresh_output=True
+            )
+    return interleaved_medians(fns, **timing)
+
+
+def strict_floor(res: dict):
+    """The smaller of the preallocated one- and two-thread floors (None if untimed)."""
+    return min(
+        (
+            v["median"]
+            for k, v in res.items()
+            if k in ("floor 1c", "floor 2c") and "median" in v
+        ),
+        default=None,
+    )
+
+
+def verdict(
+    r: Row, res: dict, single: bool, *, peers, short, single_limit_us, floor_factor
+):
+    """``("ok" | "MISS ...", {peer: median})`` for one row of one size."""
+    rk = res.get("rigidkit", {}).get("median")
+    times = {k: v["median"] for k, v in res.items() if k in peers and "median" in v}
+    if rk is None:
+        return "no rigidkit", times
+    misses = []
+    if single:
+        sc = times.get("scipy")
+        if sc is not None and rk > sc:
+            misses.append(f"{rk / sc:.3g}x scipy")
+        if rk * 1e6 > single_limit_us:
+            misses.append(f"> {single_limit_us:g} us")
+    else:
+        if times:
+            best = min(times, key=times.get)
+            if rk > times[best]:
+                misses.append(f"{rk / times[best]:.3g}x {short.get(best, best)}")
+        fl = strict_floor(res)
+        if r.memory_bound and fl is not None and rk > floor_factor * fl:
+            misses.append(f"{rk / fl:.3g}x floor")
+    return ("ok" if not misses else "MISS " + ", ".join(misses)), times
+
+
+def report_size(
+    n, rows, results, checks, *, contenders, peers, short, single_limit_us, floor_factor
+) -> str:
+    """The table of one batch size: times, ratios, verdicts and footnotes.
+
+    ``checks`` maps ``(row key, contender)`` to the message of a failed correctness
+    check: such a cell is marked ``!``; a contender with a note in ``r.notes`` is
+    marked ``*``. Rows marked ``#`` are not held to the floor target.
+    """
+    single = n == 1
+    unit = "us/call" if single else "ns/element"
+    scale = 1e6 if single else 1e9 / n
+    present = [r for r in rows if r.key in results]
+    cols = [c for c in contenders if any(c in results[r.key] for r in present)]
+    floor_cols = (
+        []
+        if single
+        else [c for c in FLOOR_COLUMNS if any(c in results[r.key] for r in present)]
+    )
+    headers = ["op"] + [short.get(c, c) for c in cols + floor_cols]
+    headers += ["rk/scipy", "rk/peer"] + ([] if single else ["rk/floor"]) + ["target"]
+    lines = []
+    foot = {}
+    for r in present:
+        res = results[r.key]
+        cells = [r.key + ("" if single or r.memory_bound else " #")]
+        for c in cols + floor_cols:
+            x = res.get(c)
+            if x is None:
+                cells.append("")
+            elif "error" in x:
+                cells.append("err")
+                foot[(r.key, c)] = x["error"]
+            else:
+                mark = ""
+                if (r.key, c) in checks:
+                    mark = "!"
+                    foot[(r.key, c)] = "WRONG RESULT: " + checks[(r.key, c)]
+                elif c in r.notes:
+                    mark = "*"
+                    foot[(r.key, c)] = r.notes[c]
+                cells.append(fmt(x["median"] * scale) + mark)
+        text, times = verdict(
+            r,
+            res,
+            single,
+            peers=peers,
+            short=short,
+            single_limit_us=single_limit_us,
+            floor_factor=floor_factor,
+        )
+        rk = res.get("rigidkit", {}).get("median")
+        sc = times.get("scipy")
+        best = min(times.values()) if times else None
+        cells.append(fmt(rk / sc) if rk and sc else "-")
+        cells.append(fmt(rk / best) if rk and best else "-")
+        if not single:
+            fl = strict_floor(res)
+            cells.append(fmt(rk / fl) if rk and fl else "-")
+        cells.append(text)
+        lines.append(cells)
+    out = [f"N = {n:,}  ({unit}, median)", table(headers, lines)]
+    if foot:
+        out.append("")
+        for (key, c), note in foot.items():
+            out.append(f"  [{key} / {short.get(c, c)}] {note}")
     return "\n".join(out)
