@@ -29,6 +29,8 @@ True
 
 from __future__ import annotations
 
+import numpy as np
+
 from . import conversions as _conv
 from ._engine.namespace import namespace_of
 from ._validate import _to_numpy, as_array, batch_index, check_finite, where_text
@@ -189,8 +191,13 @@ def check_bottom_row(M, atol, kind, error):
     ``kind`` names the kind in the message (``"a rigid transform"``), ``atol``
     defaults to :func:`rigidkit.conversions.default_atol` of the dtype.
     """
-    xp = namespace_of(M)
     tol = _conv.default_atol(M.dtype) if atol is None else atol
+    if isinstance(M, np.ndarray) and M.ndim == 2:
+        # One matrix: four float comparisons cost less than one ufunc call.
+        a, b, c, d = M[3].tolist()
+        if max(abs(a), abs(b), abs(c), abs(d - 1.0)) <= tol:
+            return
+    xp = namespace_of(M)
     bottom = M[..., 3, :]
     bad = xp.any(xp.abs(bottom[..., :3]) > tol, axis=-1) | (
         xp.abs(bottom[..., 3] - 1.0) > tol
