@@ -674,3 +674,24 @@ def test_sympy_twin_of_exp():
     R = SciRot.from_quat(got[:4], scalar_first=True).as_matrix()
     np.testing.assert_allclose(R, ref[:3, :3], rtol=0, atol=4 * EPS)
     np.testing.assert_allclose(got[4:], ref[:3, 3], rtol=0, atol=4 * EPS)
+
+
+def test_compose_into_buffer_matches_scipy():
+    """Transform.compose(out=) / Rotation.compose(out=) write into the caller's buffer."""
+    from scipy.spatial.transform import RigidTransform
+
+    rng = np.random.default_rng(21)
+    for n in (1, 7, 5000):
+        A = rk.Transform.random(n, rng)
+        B = rk.Transform.random(n, rng)
+        buf = np.empty((n, 7))
+        C = A.compose(B, out=buf)
+        ref = RigidTransform.from_matrix(A.as_matrix()) * RigidTransform.from_matrix(
+            B.as_matrix()
+        )
+        np.testing.assert_allclose(C.as_matrix(), ref.as_matrix(), atol=1e-14)
+        assert np.shares_memory(buf, C._pose)
+        qbuf = np.empty((n, 4))
+        R = A.rotation.compose(B.rotation, out=qbuf)
+        np.testing.assert_allclose(R.as_matrix(), ref.rotation.as_matrix(), atol=1e-14)
+        assert np.shares_memory(qbuf, R._quat)

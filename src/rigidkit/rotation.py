@@ -202,6 +202,14 @@ class Rotation(BatchedArray, LieGroup):
             return NotImplemented  # e.g. Rotation @ Affine: the more general kind decides
         return self.apply(other)
 
+    def compose(self, other, *, out=None):
+        """``self @ other`` (``other`` first), optionally into a quaternion buffer.
+
+        ``out``: a C-contiguous NumPy array of shape ``batch + (4,)`` that receives
+        the quaternions; the result wraps it (no copy).
+        """
+        return Rotation._wrap(_conv.quat_multiply(self._quat, other._quat, out=out))
+
     def __rmatmul__(self, other):
         raise TypeError(
             "array @ Rotation is not defined; rotate vectors with R @ v or R.apply(v)"

@@ -181,6 +181,15 @@ class Transform(BatchedArray, LieGroup):
             "array @ Transform is not defined; move points with T @ p or T.apply(p)"
         )
 
+    def compose(self, other, *, out=None):
+        """``self @ other`` (``other`` first), optionally into a pose buffer.
+
+        ``out``: a C-contiguous NumPy array of shape ``batch + (7,)`` that receives
+        the poses ``(w, x, y, z, tx, ty, tz)``; reusing one saves the page faults of
+        a fresh large output. The result wraps ``out`` (no copy).
+        """
+        return Transform._wrap(_k.pose_compose(self._pose, other._pose, out=out))
+
     def apply(self, points, *, out=None):
         """Move points: ``R p + t``, shape (..., 3) broadcasting with the batch shape."""
         return _k.pose_apply(self._pose, as_array(points, (3,), "points"), out=out)
