@@ -38,7 +38,9 @@ import os
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
+import warnings
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
@@ -314,8 +316,8 @@ def table(headers, rows, *, left: int = 1) -> str:
 # -- a table of ops, side by side --------------------------------------------------------
 #
 # The generic part of a "rigidkit against its peers" script: rows of ops, each with a
-# builder per contender, timed round-robin with the floor, judged against the targets
-# and printed. (bench_so3.py predates these and keeps its own copies.)
+# builder per contender, checked against scipy, timed round-robin with the floor,
+# judged against the targets and printed.
 
 
 @dataclass
@@ -335,6 +337,18 @@ class Row:
     batched_only: bool = False
     impls: dict = field(default_factory=dict)
     notes: dict = field(default_factory=dict)  # contender -> footnote
+
+
+def buffer(shape) -> np.ndarray:
+    """A float64 output buffer for ``out=``, built before timing."""
+    b = np.empty(shape)
+    b.fill(0.0)  # a reused buffer: its pages are already mapped
+    return b
+
+
+def per_size(single, batch):
+    """A builder that is ``single`` for one element and ``batch`` for a batch."""
+    return lambda d: single(d) if d.single else batch(d)
 
 
 def with_threads(builder, count: int, env: str = "RIGIDKIT_NUM_THREADS"):
@@ -359,6 +373,46 @@ def with_threads(builder, count: int, env: str = "RIGIDKIT_NUM_THREADS"):
         return call
 
     return build
+
+
+def check_rows(rows, make_data, canonical, error, sizes) -> dict:
+    """Run every contender on ``make_data(n)`` and compare with scipy.
+
+    ``canonical(kind, lib, result)`` brings any contender's result to one form;
+    ``error(result, reference)`` returns a message where they disagree, else None.
+    A row without scipy (an ``out=`` variant) is compared with its plain op's
+    scipy. Returns ``{(row key, contender): message}``.
+    """
+    bad = {}
+    for n in sizes:
+        d = make_data(n)
+        for r in rows:
+            if r.batched_only and d.single:
+                continue
+            results = {}
+            for lib, builder in r.impls.items():
+                try:
+                    fn = builder(d)
+                    if fn is None:
+                        continue
+                    with warnings.catch_warnings():
+                        warnings.simplefilter("ignore")
+                        results[lib] = canonical(r.kind, lib, fn())
+                except Exception as exc:
+                    bad[(r.key, lib)] = f"{type(exc).__name__}: {exc}"[:160]
+            ref = results.get("scipy")
+            if ref is None:
+                base = next((x for x in rows if x.key == r.key.replace(" out=", "")), None)
+                if base is not None and "scipy" in base.impls:
+                    ref = canonical(base.kind, "scipy", base.impls["scipy"](d)())
+            if ref is None:
+                continue
+            for lib, res in results.items():
+                msg = error(np.asarray(res, dtype=float), ref)
+                if msg:
+                    bad[(r.key, lib)] = f"{msg} (n={n})"
+        del d
+    return bad
 
 
 FLOOR_COLUMNS = ("floor 1c", "floor 2c", "floor+alloc 1c", "floor+alloc 2c")
@@ -425,13 +479,24 @@ def verdict(
 
 
 def report_size(
-    n, rows, results, checks, *, contenders, peers, short, single_limit_us, floor_factor
+    n,
+    rows,
+    results,
+    checks,
+    *,
+    contenders,
+    peers,
+    short,
+    single_limit_us,
+    floor_factor,
+    mark_unbounded=True,
 ) -> str:
     """The table of one batch size: times, ratios, verdicts and footnotes.
 
     ``checks`` maps ``(row key, contender)`` to the message of a failed correctness
     check: such a cell is marked ``!``; a contender with a note in ``r.notes`` is
-    marked ``*``. Rows marked ``#`` are not held to the floor target.
+    marked ``*``. With ``mark_unbounded``, rows marked ``#`` are not held to the
+    floor target.
     """
     single = n == 1
     unit = "us/call" if single else "ns/element"
@@ -449,7 +514,8 @@ def report_size(
     foot = {}
     for r in present:
         res = results[r.key]
-        cells = [r.key + ("" if single or r.memory_bound else " #")]
+        unbounded = mark_unbounded and not (single or r.memory_bound)
+        cells = [r.key + (" #" if unbounded else "")]
         for c in cols + floor_cols:
             x = res.get(c)
             if x is None:
@@ -491,3 +557,39 @@ def report_size(
         for (key, c), note in foot.items():
             out.append(f"  [{key} / {short.get(c, c)}] {note}")
     return "\n".join(out)
+
+
+# -- the first call in a fresh process ---------------------------------------------------
+
+
+def fresh_process(code: str, sizes) -> dict:
+    """Run ``code`` (``SIZES`` replaced by ``sizes``) with an empty kernel cache."""
+    with tempfile.TemporaryDirectory(prefix="rigidkit-cache-") as cache:
+        code = code.replace("SIZES", repr(list(sizes)))
+        return run_python(code, env={"RIGIDKIT_CACHE_DIR": cache})
+
+
+def report_fresh(fc: dict, sizes) -> str:
+    """The first and second call of every op of :func:`fresh_process`, as a table."""
+    hdr = ["op"]
+    for n in sizes:
+        hdr += [f"1st call N={n} (ms)", "2nd (ms)", "JIT?"]
+    lines = []
+    for name in next(iter(fc["sizes"].values())):
+        cells = [name]
+        for n in sizes:
+            x = fc["sizes"][str(n)][name]
+            if "error" in x:
+                cells += ["err", "", x["error"][:40]]
+            else:
+                cells += [
+                    fmt(x["first_s"] * 1e3),
+                    fmt(x["second_s"] * 1e3),
+                    "COMPILED" if x["compiled"] else "no",
+                ]
+        lines.append(cells)
+    head = (
+        f"fresh process, empty RIGIDKIT_CACHE_DIR: import {fc['import_s'] * 1e3:.1f} ms, "
+        f"numba imported by the end: {fc['numba_imported']}"
+    )
+    return head + "\n" + table(hdr, lines)

@@ -23,7 +23,6 @@ import operator
 import os
 import platform
 import sys
-import tempfile
 import warnings
 from dataclasses import dataclass, field
 from functools import partial
@@ -245,14 +244,7 @@ def build_rows(libs: Libs) -> list:
 
     rko, sco, pto, dqo = o("rk"), o("scipy"), o("pt3d"), o("dq")
 
-    def buffer(shape):
-        b = np.empty(shape)
-        b.fill(0.0)  # a reused buffer: its pages are already mapped
-        return b
-
-    def per_size(single, batch):
-        return lambda d: single(d) if d.single else batch(d)
-
+    buffer, per_size = C.buffer, C.per_size
     rows = []
 
     def row(key, floor, memory_bound, kind, batched_only=False):
@@ -473,40 +465,20 @@ def check_rows(rows, libs, sizes=(1, 5, 250_000)) -> dict:
     above both the numba threshold and the thread split, so the timed paths are
     the checked ones.
     """
-    bad = {}
-    for n in sizes:
-        d = make_data(n, seed=1)
-        for r in rows:
-            if r.batched_only and d.single:
-                continue
-            results = {}
-            for lib, builder in r.impls.items():
-                try:
-                    fn = builder(d)
-                    if fn is None:
-                        continue
-                    with warnings.catch_warnings():
-                        warnings.simplefilter("ignore")
-                        results[lib] = canonical(r.kind, lib, fn(), libs)
-                except Exception as exc:
-                    bad[(r.key, lib)] = f"{type(exc).__name__}: {exc}"[:160]
-            ref = results.get("scipy")
-            if ref is None:  # rows without scipy (out= variants): the plain op's scipy
-                base = next((x for x in rows if x.key == r.key.replace(" out=", "")), None)
-                if base is not None and "scipy" in base.impls:
-                    ref = canonical(base.kind, "scipy", base.impls["scipy"](d)(), libs)
-            if ref is None:
-                continue
-            for lib, res in results.items():
-                res = np.asarray(res, dtype=float)
-                if res.shape != ref.shape:
-                    bad[(r.key, lib)] = f"shape {res.shape}, scipy {ref.shape} (n={n})"
-                    continue
-                err = float(np.max(np.abs(res - ref) / (1.0 + np.abs(ref))))
-                if not err <= 1e-9:
-                    bad[(r.key, lib)] = f"differs from scipy by {err:.3g} (n={n})"
-        del d
-    return bad
+
+    def error(res, ref):
+        if res.shape != ref.shape:
+            return f"shape {res.shape}, scipy {ref.shape}"
+        err = float(np.max(np.abs(res - ref) / (1.0 + np.abs(ref))))
+        return None if err <= 1e-9 else f"differs from scipy by {err:.3g}"
+
+    return C.check_rows(
+        rows,
+        lambda n: make_data(n, seed=1),
+        lambda kind, lib, x: canonical(kind, lib, x, libs),
+        error,
+        sizes,
+    )
 
 
 # -- fresh process ---------------------------------------------------------------------
@@ -572,37 +544,6 @@ for n in SIZES:
 out["numba_imported"] = "numba" in sys.modules
 print(json.dumps(out))
 """
-
-
-def fresh_process(sizes) -> dict:
-    with tempfile.TemporaryDirectory(prefix="rigidkit-cache-") as cache:
-        code = FIRST_CALL_CODE.replace("SIZES", repr(list(sizes)))
-        return C.run_python(code, env={"RIGIDKIT_CACHE_DIR": cache})
-
-
-def report_fresh(fc, sizes) -> str:
-    hdr = ["op"]
-    for n in sizes:
-        hdr += [f"1st call N={n} (ms)", "2nd (ms)", "JIT?"]
-    lines = []
-    for name in next(iter(fc["sizes"].values())):
-        cells = [name]
-        for n in sizes:
-            x = fc["sizes"][str(n)][name]
-            if "error" in x:
-                cells += ["err", "", x["error"][:40]]
-            else:
-                cells += [
-                    C.fmt(x["first_s"] * 1e3),
-                    C.fmt(x["second_s"] * 1e3),
-                    "COMPILED" if x["compiled"] else "no",
-                ]
-        lines.append(cells)
-    head = (
-        f"fresh process, empty RIGIDKIT_CACHE_DIR: import {fc['import_s'] * 1e3:.1f} ms, "
-        f"numba imported by the end: {fc['numba_imported']}"
-    )
-    return head + "\n" + C.table(hdr, lines)
 
 
 # -- main ------------------------------------------------------------------------------
@@ -715,10 +656,10 @@ def main(argv=None):
     record["meta"]["load_end"] = C.load_average()
 
     if not args.no_fresh and args.first_call_sizes:
-        fc = fresh_process(args.first_call_sizes)
+        fc = C.fresh_process(FIRST_CALL_CODE, args.first_call_sizes)
         record["first_call"] = fc
         print()
-        print(report_fresh(fc, args.first_call_sizes))
+        print(C.report_fresh(fc, args.first_call_sizes))
 
     if args.json:
         with open(args.json, "w") as fh:

@@ -24,7 +24,6 @@ import operator
 import os
 import platform
 import sys
-import tempfile
 import warnings
 from dataclasses import dataclass, field
 from functools import partial
@@ -68,6 +67,14 @@ SHORT = {
     "floor+alloc 1c": "+alloc 1c",
     "floor+alloc 2c": "+alloc 2c",
 }
+TABLE = dict(
+    contenders=LIBS,
+    peers=PEERS,
+    short=SHORT,
+    single_limit_us=SINGLE_LIMIT_US,
+    floor_factor=FLOOR_FACTOR,
+    mark_unbounded=False,
+)
 
 
 # -- optional libraries ----------------------------------------------------------------
@@ -159,20 +166,7 @@ def make_data(n, libs, seed=0) -> Data:
 # -- the ops ---------------------------------------------------------------------------
 
 
-@dataclass
-class Row:
-    """One line of the table: an op (or its ``out=`` variant) and who can do it."""
-
-    key: str
-    floor: tuple  # (input widths, output width) in float64 components per element
-    memory_bound: bool
-    kind: str  # what the result is compared as: "rot", "vec", "mat", "euler:SEQ", "rotvec"
-    batched_only: bool = False
-    impls: dict = field(default_factory=dict)  # lib -> builder(data) -> callable
-    notes: dict = field(default_factory=dict)  # lib -> footnote
-
-
-def build_rows(libs: Libs) -> list[Row]:
+def build_rows(libs: Libs) -> list:
     """Every row, with a builder per library: ``builder(data) -> zero-argument callable``.
 
     Builders prepare everything that is not the op (library objects, output
@@ -194,21 +188,15 @@ def build_rows(libs: Libs) -> list[Row]:
             d.objects[lib] = tuple(make(q) for q in (d.q1, d.q2, d.q0))
         return d.objects[lib]
 
-    def buffer(shape):
-        b = np.empty(shape)
-        b.fill(0.0)  # a reused buffer: its pages are already mapped
-        return b
+    buffer, per_size = C.buffer, C.per_size
 
     def batched(make):
         return lambda d: None if d.single else make(d)
 
-    def per_size(single, batch):
-        return lambda d: single(d) if d.single else batch(d)
-
     rows = []
 
     def row(key, floor, memory_bound, kind, batched_only=False):
-        r = Row(key, floor, memory_bound, kind, batched_only)
+        r = C.Row(key, floor, memory_bound, kind, batched_only)
         rows.append(r)
         return r
 
@@ -443,31 +431,9 @@ def build_rows(libs: Libs) -> list[Row]:
     # "rigidkit" column is the library's own choice (it counts idle cores).
     for r in rows:
         if "rigidkit" in r.impls:
-            r.impls["rk 1t"] = _threads(r.impls["rigidkit"], 1)
-            r.impls["rk 2t"] = _threads(r.impls["rigidkit"], 2)
+            r.impls["rk 1t"] = C.with_threads(r.impls["rigidkit"], 1)
+            r.impls["rk 2t"] = C.with_threads(r.impls["rigidkit"], 2)
     return rows
-
-
-def _threads(builder, count):
-    def build(d):
-        fn = builder(d)
-        if fn is None or d.single or count > C.cpu_count():
-            return None
-
-        def call():
-            saved = os.environ.get("RIGIDKIT_NUM_THREADS")
-            os.environ["RIGIDKIT_NUM_THREADS"] = str(count)
-            try:
-                return fn()
-            finally:
-                if saved is None:
-                    del os.environ["RIGIDKIT_NUM_THREADS"]
-                else:
-                    os.environ["RIGIDKIT_NUM_THREADS"] = saved
-
-        return call
-
-    return build
 
 
 # -- correctness check of what is timed ------------------------------------------------
@@ -515,88 +481,18 @@ def canonical(kind, lib, x, libs):
 
 def check_rows(rows, libs, sizes=(1, 5)) -> dict:
     """Run every contender on small inputs and compare with scipy: (row, lib) -> error."""
-    bad = {}
-    for n in sizes:
-        d = make_data(n, libs, seed=1)
-        for r in rows:
-            if r.batched_only and d.single:
-                continue
-            ref = None
-            results = {}
-            for lib, builder in r.impls.items():
-                try:
-                    fn = builder(d)
-                    if fn is None:
-                        continue
-                    with warnings.catch_warnings():
-                        warnings.simplefilter("ignore")
-                        results[lib] = canonical(r.kind, lib, fn(), libs)
-                except Exception as exc:
-                    bad[(r.key, lib)] = f"{type(exc).__name__}: {exc}"[:160]
-            ref = results.get("scipy")
-            if ref is None:  # rows without scipy (out= variants): the plain op's scipy
-                base = next((x for x in rows if x.key == r.key.replace(" out=", "")), None)
-                if base is not None and "scipy" in base.impls:
-                    ref = canonical(base.kind, "scipy", base.impls["scipy"](d)(), libs)
-            if ref is None:
-                continue
-            for lib, res in results.items():
-                err = float(np.max(np.abs(np.asarray(res, dtype=float) - ref)))
-                if not err <= 1e-9:
-                    bad[(r.key, lib)] = f"differs from scipy by {err:.3g} (n={n})"
-    return bad
 
+    def error(res, ref):
+        err = float(np.max(np.abs(res - ref)))
+        return None if err <= 1e-9 else f"differs from scipy by {err:.3g}"
 
-# -- timing ----------------------------------------------------------------------------
-
-
-def time_row(r: Row, d: Data, args, floors: bool) -> dict:
-    fns = {}
-    for lib in LIBS:
-        if lib in r.impls and lib in args.libs:
-            fn = r.impls[lib](d)
-            if fn is not None:
-                fns[lib] = fn
-    if floors and not d.single and "floor" in args.libs:
-        ins, out = r.floor
-        if r.key.startswith("apply cloud"):
-            ins = [3]
-        fl = C.StreamFloor(ins, out)
-        for cores in args.threads:
-            fns[f"floor {cores}c"] = fl.callable(d.n, threads=cores)
-            fns[f"floor+alloc {cores}c"] = fl.callable(
-                d.n, threads=cores, fresh_output=True
-            )
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # GimbalLockWarning and the like: not timed
-        return C.interleaved_medians(
-            fns, repeat=args.repeat, warmup=args.warmup, min_sample=args.min_sample
-        )
-
-
-def verdict(r: Row, res: dict, single: bool):
-    rk = res.get("rigidkit", {}).get("median")
-    if rk is None:
-        return "no rigidkit", None
-    peers = {k: v["median"] for k, v in res.items() if k in PEERS and "median" in v}
-    misses = []
-    if single:
-        sc = peers.get("scipy")
-        if sc is not None and rk > sc:
-            misses.append(f"{rk / sc:.3g}x scipy")
-        if rk * 1e6 > SINGLE_LIMIT_US:
-            misses.append(f"> {SINGLE_LIMIT_US:g} us")
-        return ("ok" if not misses else "MISS " + ", ".join(misses)), peers
-    if peers:
-        best = min(peers, key=peers.get)
-        if rk > peers[best]:
-            misses.append(f"{rk / peers[best]:.3g}x {SHORT[best]}")
-    floor = min(
-        (v["median"] for k, v in res.items() if k in ("floor 1c", "floor 2c")), default=None
+    return C.check_rows(
+        rows,
+        lambda n: make_data(n, libs, seed=1),
+        lambda kind, lib, x: canonical(kind, lib, x, libs),
+        error,
+        sizes,
     )
-    if r.memory_bound and floor is not None and rk > FLOOR_FACTOR * floor:
-        misses.append(f"{rk / floor:.3g}x floor")
-    return ("ok" if not misses else "MISS " + ", ".join(misses)), peers
 
 
 # -- fresh-process measurements --------------------------------------------------------
@@ -657,77 +553,6 @@ print(json.dumps(out))
 """
 
 
-def fresh_process(sizes) -> dict:
-    with tempfile.TemporaryDirectory(prefix="rigidkit-cache-") as cache:
-        code = FIRST_CALL_CODE.replace("SIZES", repr(list(sizes)))
-        return C.run_python(code, env={"RIGIDKIT_CACHE_DIR": cache})
-
-
-# -- report ----------------------------------------------------------------------------
-
-
-def report_size(n, rows, results, checks, libs) -> str:
-    single = n == 1
-    unit = "us/call" if single else "ns/element"
-    scale = 1e6 if single else 1e9 / n
-    cols = [c for c in LIBS if any(c in results[r.key] for r in rows if r.key in results)]
-    floor_cols = (
-        []
-        if single
-        else [
-            c
-            for c in ("floor 1c", "floor 2c", "floor+alloc 1c", "floor+alloc 2c")
-            if any(c in results[r.key] for r in rows if r.key in results)
-        ]
-    )
-    headers = ["op"] + [SHORT[c] for c in cols + floor_cols]
-    headers += ["rk/scipy", "rk/peer"] + ([] if single else ["rk/floor"]) + ["target"]
-    lines = []
-    foot = {}
-    for r in rows:
-        if r.key not in results:
-            continue
-        res = results[r.key]
-        cells = [r.key]
-        for c in cols + floor_cols:
-            x = res.get(c)
-            if x is None:
-                cells.append("")
-            elif "error" in x:
-                cells.append("err")
-                foot[(r.key, c)] = x["error"]
-            else:
-                mark = ""
-                if (r.key, c) in checks:
-                    mark = "!"
-                    foot[(r.key, c)] = "WRONG RESULT: " + checks[(r.key, c)]
-                elif c in r.notes:
-                    mark = "*"
-                    foot[(r.key, c)] = r.notes[c]
-                cells.append(C.fmt(x["median"] * scale) + mark)
-        text, peers = verdict(r, res, single)
-        rk = res.get("rigidkit", {}).get("median")
-        sc = (peers or {}).get("scipy")
-        best = min(peers.values()) if peers else None
-        cells.append(C.fmt(rk / sc, 3) if rk and sc else "-")
-        cells.append(C.fmt(rk / best, 3) if rk and best else "-")
-        if not single:
-            fl = min(
-                (v["median"] for k, v in res.items() if k in ("floor 1c", "floor 2c")),
-                default=None,
-            )
-            cells.append(C.fmt(rk / fl, 3) if rk and fl else "-")
-        cells.append(text)
-        lines.append(cells)
-    title = f"N = {n:,}  ({unit}, median)"
-    out = [title, C.table(headers, lines)]
-    if foot:
-        out.append("")
-        for (key, c), note in foot.items():
-            out.append(f"  [{key} / {SHORT.get(c, c)}] {note}")
-    return "\n".join(out)
-
-
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--sizes", type=int, nargs="+", default=[1, 1_000_000])
@@ -761,14 +586,15 @@ def main(argv=None):
         # Work done on other threads would not be counted: keep everything on one.
         os.environ["RIGIDKIT_NUM_THREADS"] = "1"
         args.libs = [lib for lib in args.libs if lib != "rk 2t"]
-        args.threads = [1]
+        threads = [1]
     else:
-        args.threads = sorted({1, min(2, C.cpu_count())})
+        threads = sorted({1, min(2, C.cpu_count())})
 
     libs = Libs()
     rows = build_rows(libs)
     if args.ops:
         rows = [r for r in rows if any(r.key.startswith(o) for o in args.ops)]
+    contenders = [c for c in LIBS if c in args.libs]
 
     print(
         f"rigidkit {libs.rk.__version__}, numpy {np.__version__}, "
@@ -815,10 +641,21 @@ def main(argv=None):
         for r in rows:
             if r.batched_only and d.single:
                 continue
-            results[r.key] = time_row(r, d, args, floors=True)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # GimbalLockWarning and the like: not timed
+                results[r.key] = C.time_row(
+                    r,
+                    d,
+                    contenders,
+                    threads=threads,
+                    floor="floor" in args.libs,
+                    repeat=args.repeat,
+                    warmup=args.warmup,
+                    min_sample=args.min_sample,
+                )
             print(f"  timed {r.key:>18} at N={n}", file=sys.stderr, flush=True)
         print()
-        print(report_size(n, rows, results, checks, libs))
+        print(C.report_size(n, rows, results, checks, **dict(TABLE, contenders=contenders)))
         record["sizes"][str(n)] = results
         del d
 
@@ -847,32 +684,9 @@ def main(argv=None):
             "profile": prof,
         }
         if args.first_call_sizes:
-            fc = fresh_process(args.first_call_sizes)
+            fc = C.fresh_process(FIRST_CALL_CODE, args.first_call_sizes)
             record["first_call"] = fc
-            print(
-                "fresh process, empty RIGIDKIT_CACHE_DIR: import "
-                f"{fc['import_s'] * 1e3:.1f} ms, "
-                f"numba imported by the end: {fc['numba_imported']}"
-            )
-            hdr = ["op"]
-            for n in args.first_call_sizes:
-                hdr += [f"1st call N={n} (ms)", "2nd (ms)", "JIT?"]
-            lines = []
-            names = list(next(iter(fc["sizes"].values())).keys())
-            for name in names:
-                cells = [name]
-                for n in args.first_call_sizes:
-                    x = fc["sizes"][str(n)][name]
-                    if "error" in x:
-                        cells += ["err", "", x["error"][:40]]
-                    else:
-                        cells += [
-                            C.fmt(x["first_s"] * 1e3),
-                            C.fmt(x["second_s"] * 1e3),
-                            "COMPILED" if x["compiled"] else "no",
-                        ]
-                lines.append(cells)
-            print(C.table(hdr, lines))
+            print(C.report_fresh(fc, args.first_call_sizes))
 
     if args.json:
         with open(args.json, "w") as fh:
