@@ -308,6 +308,8 @@ class Kernel(_Rebindable):
                     f"{self.name}: argument {k} has shape {shape}, expected {want}"
                 )
             shapes.append(shape[: len(shape) - nt])
+        if all(s == shapes[0] for s in shapes):  # the common case; skips ~3 us
+            return shapes[0] if shapes else ()
         try:
             return tuple(np.broadcast_shapes(*shapes))
         except ValueError:

@@ -124,6 +124,9 @@ def float_dtype_of(xp, *arrays):
     """The floating dtype of a result: that of the inputs, float64 for ints."""
     if is_numpy(xp):
         dts = [np.asarray(a).dtype for a in arrays]
+        if dts and (dts[0] is _NP_F64 or dts[0] is _NP_F32):
+            if all(d is dts[0] for d in dts):  # the common case, without result_type
+                return dts[0]
         dt = np.result_type(*dts) if dts else np.dtype(np.float64)
         if not np.issubdtype(dt, np.floating):
             return np.dtype(np.float64)
