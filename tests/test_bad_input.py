@@ -259,3 +259,20 @@ def test_batches_that_do_not_broadcast():
 )
 def test_non_real_input(value):
     _raises(rk.ShapeError, lambda: rk.Rotation.from_quat(value), "real")
+
+
+@pytest.mark.parametrize(
+    "module, dof", [("so2", 1), ("se2", 3), ("so3", 3), ("se3", 6), ("sim3", 7)]
+)
+@pytest.mark.parametrize("bad", [np.nan, np.inf])
+def test_every_tangent_check_rejects_non_finite(module, dof, bad):
+    """exp of every functional layer rejects NaN/inf, naming the batch index.
+
+    (hat/vee/ad are linear reshuffles and only check shapes: NaN stays visible.)
+    """
+    import rigidkit as rk
+
+    xi = np.zeros((2, 3, dof))
+    xi[1, 2, 0] = bad
+    with pytest.raises(rk.NonFiniteError, match=r"\(1, 2\)"):
+        getattr(rk, module).exp(xi)

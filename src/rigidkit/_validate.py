@@ -68,3 +68,10 @@ def check_finite(x, trail: tuple, what: str) -> None:
     if trail:
         bad = bad.reshape(bad.shape[: bad.ndim - len(trail)] + (-1,)).any(axis=-1)
     raise NonFiniteError(f"{what} contains NaN or infinity {where_text(batch_index(bad))}")
+
+
+def finite_array(x, trail: tuple, what: str):
+    """:func:`as_array` then :func:`check_finite`: the check of every user array."""
+    x = as_array(x, trail, what)
+    check_finite(x, trail, what)
+    return x

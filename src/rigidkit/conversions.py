@@ -20,7 +20,7 @@ import math
 import numpy as np
 
 from ._engine.namespace import is_float32, is_numpy, namespace_of
-from ._validate import as_array, batch_index, check_finite, where_text
+from ._validate import as_array, batch_index, check_finite, finite_array, where_text
 from .errors import NotARotationError, ZeroNormError
 from .kernels import axis_angle as _aa
 from .kernels import matrix as _mat
@@ -196,15 +196,13 @@ def nearest_rotation_matrix(matrix):
 
 def quat_from_rotvec(rotvec):
     """Unit quaternion of a rotation vector ``theta * axis`` (radians)."""
-    r = as_array(rotvec, (3,), "rotation vector")
-    check_finite(r, (3,), "rotation vector")
+    r = finite_array(rotvec, (3,), "rotation vector")
     return _rv.quat_from_rotvec(r)
 
 
 def quat_from_mrp(mrp):
     """Unit quaternion of modified Rodrigues parameters ``axis * tan(theta/4)``."""
-    p = as_array(mrp, (3,), "MRP")
-    check_finite(p, (3,), "MRP")
+    p = finite_array(mrp, (3,), "MRP")
     return _mrp.quat_from_mrp(p)
 
 

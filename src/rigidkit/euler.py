@@ -51,7 +51,7 @@ import numpy as np
 
 from . import conversions as _conv
 from ._engine.namespace import is_float32, namespace_of
-from ._validate import as_array, batch_index, check_finite, where_text
+from ._validate import batch_index, finite_array, where_text
 from .errors import EulerSequenceError, GimbalLockWarning
 from .kernels import euler as _k
 
@@ -245,8 +245,7 @@ def quat_from_euler(seq, angles, *, degrees=False):
     array([0.70710678, 0.70710678, 0.        , 0.        ])
     """
     s = parse_sequence(seq)
-    a = as_array(angles, (3,), f"Euler angles for {seq!r}")
-    check_finite(a, (3,), f"Euler angles for {seq!r}")
+    a = finite_array(angles, (3,), f"Euler angles for {seq!r}")
     scale = math.pi / 180.0 if degrees else 1.0
     return _k.quat_from_euler(*s.params, scale, a)
 

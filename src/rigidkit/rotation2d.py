@@ -16,7 +16,7 @@ import numpy as np
 from . import so2 as _so2
 from ._batch import BatchedArray, batch_shape
 from ._engine.namespace import is_numpy, is_torch, namespace_of
-from ._validate import _to_numpy, as_array, check_finite
+from ._validate import _to_numpy, as_array, check_finite, finite_array
 from .errors import ShapeError
 from .group import LieGroup
 from .kernels import so2 as _k
@@ -68,8 +68,7 @@ class Rotation2D(BatchedArray, LieGroup):
         >>> Rotation2D.from_angle([0.0, -np.pi]).angle
         array([0.        , 3.14159265])
         """
-        t = as_array(angle, (), "angle")
-        check_finite(t, (), "angle")
+        t = finite_array(angle, (), "angle")
         if degrees:
             t = t * (math.pi / 180.0)
         return cls._wrap(_k.complex_from_angle(t[..., None]))

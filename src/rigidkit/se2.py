@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._engine.namespace import namespace_of
-from ._validate import as_array, batch_index, check_finite, where_text
+from ._validate import as_array, batch_index, finite_array, where_text
 from .conversions import default_atol
 from .errors import NotARigidTransformError
 from .kernels import se2 as _k
@@ -50,9 +50,7 @@ __all__ = [
 
 
 def _twist(xi, what="se(2) twist"):
-    xi = as_array(xi, (3,), what)
-    check_finite(xi, (3,), what)
-    return xi
+    return finite_array(xi, (3,), what)
 
 
 def hat(xi):
@@ -178,8 +176,7 @@ def pose_from_matrix(matrix, *, atol=None, orthonormalize=False):
     NonFiniteError, NotARotationError
         Naming the first offending batch index.
     """
-    m = as_array(matrix, (3, 3), "SE(2) matrix")
-    check_finite(m, (3, 3), "SE(2) matrix")
+    m = finite_array(matrix, (3, 3), "SE(2) matrix")
     pose, norm, err, bottom = _k.pose_from_matrix(m)
     tol = default_atol(getattr(err, "dtype", "float64")) if atol is None else atol
     bad = bottom > tol

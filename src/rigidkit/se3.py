@@ -33,7 +33,13 @@ import numpy as np
 
 from . import conversions as _conv
 from ._engine.namespace import namespace_of
-from ._validate import _to_numpy, as_array, batch_index, check_finite, where_text
+from ._validate import (
+    _to_numpy,
+    as_array,
+    batch_index,
+    finite_array,
+    where_text,
+)
 from .errors import NotARigidTransformError, NotARotationError
 from .kernels import se3 as _k
 
@@ -60,9 +66,7 @@ twist_from_pose = _k.twist_from_pose
 
 
 def _twist(xi, what="twist"):
-    xi = as_array(xi, (6,), what)
-    check_finite(xi, (6,), what)
-    return xi
+    return finite_array(xi, (6,), what)
 
 
 def hat(xi):
@@ -174,8 +178,7 @@ def pose_from_matrix(M, *, atol=None, orthonormalize=False):
         The bottom row is not ``[0, 0, 0, 1]`` or the rotation block is not a
         rotation; the message names the first such batch index.
     """
-    M = as_array(M, (4, 4), "homogeneous matrix")
-    check_finite(M, (4, 4), "homogeneous matrix")
+    M = finite_array(M, (4, 4), "homogeneous matrix")
     check_bottom_row(M, atol, "a rigid transform", NotARigidTransformError)
     try:
         q = _conv.quat_from_matrix(M[..., :3, :3], atol=atol, orthonormalize=orthonormalize)

@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._engine.namespace import namespace_of
-from ._validate import as_array, batch_index, check_finite, where_text
+from ._validate import as_array, batch_index, finite_array, where_text
 from .conversions import default_atol
 from .errors import NotARotationError, ZeroNormError
 from .kernels import so2 as _k
@@ -47,9 +47,7 @@ __all__ = [
 
 
 def _tangent(w, what="so(2) vector"):
-    w = as_array(w, (1,), what)
-    check_finite(w, (1,), what)
-    return w
+    return finite_array(w, (1,), what)
 
 
 def hat(w):
@@ -136,8 +134,7 @@ def complex_normalize(z, *, what="complex number"):
     NonFiniteError, ZeroNormError
         For NaN/inf components or a zero pair, naming the batch index.
     """
-    z = as_array(z, (2,), what)
-    check_finite(z, (2,), what)
+    z = finite_array(z, (2,), what)
     unit, norm = _k.complex_normalize(z)
     zero = norm == 0.0
     if bool(namespace_of(norm).any(zero)):
@@ -172,8 +169,7 @@ def complex_from_matrix(matrix, *, atol=None, orthonormalize=False):
         A matrix is not a rotation within ``atol`` (a reflection, a scaling, a
         shear), naming the first such batch index and why.
     """
-    m = as_array(matrix, (2, 2), "rotation matrix")
-    check_finite(m, (2, 2), "rotation matrix")
+    m = finite_array(matrix, (2, 2), "rotation matrix")
     z, norm, err = _k.complex_from_matrix(m)
     check_rotation_block(m, norm, err, atol=atol, orthonormalize=orthonormalize)
     return z

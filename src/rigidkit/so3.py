@@ -13,7 +13,7 @@ True
 from __future__ import annotations
 
 from . import conversions as _conv
-from ._validate import as_array, check_finite
+from ._validate import as_array, finite_array
 from .kernels import rotvec as _rv
 from .kernels import so3 as _k
 
@@ -42,8 +42,7 @@ def exp(w):
     -------
     ndarray, shape (..., 3, 3)
     """
-    w = as_array(w, (3,), "rotation vector")
-    check_finite(w, (3,), "rotation vector")
+    w = finite_array(w, (3,), "rotation vector")
     return _rv.matrix_from_rotvec(w)
 
 
@@ -78,9 +77,7 @@ __all__ += [
 
 
 def _rotvec(w):
-    w = as_array(w, (3,), "rotation vector")
-    check_finite(w, (3,), "rotation vector")
-    return w
+    return finite_array(w, (3,), "rotation vector")
 
 
 def adjoint(R):

@@ -14,7 +14,7 @@ from . import conversions as _conv
 from . import se3 as _se3
 from ._batch import BatchedArray, batch_shape
 from ._engine.namespace import device_of, namespace_of
-from ._validate import _to_numpy, as_array, check_finite
+from ._validate import _to_numpy, as_array, finite_array
 from .group import LieGroup
 from .kernels import se3 as _k
 from .rotation import Rotation
@@ -71,8 +71,7 @@ class Transform(BatchedArray, LieGroup):
                 f"rotation must be a rigidkit.Rotation, got {type(rotation).__name__}"
             )
         if translation is not None:
-            translation = as_array(translation, (3,), "translation")
-            check_finite(translation, (3,), "translation")
+            translation = finite_array(translation, (3,), "translation")
         if rotation is None and translation is None:
             self._pose = self._filled(_IDENTITY, ())
             return

@@ -13,7 +13,7 @@ import numpy as np
 from . import se2 as _se2
 from ._batch import BatchedArray, batch_shape
 from ._engine.namespace import float_dtype_of, namespace_of
-from ._validate import _to_numpy, as_array, check_finite
+from ._validate import _to_numpy, as_array, finite_array
 from .group import LieGroup
 from .kernels import se2 as _k
 from .rotation2d import Rotation2D
@@ -67,8 +67,7 @@ class Transform2D(BatchedArray, LieGroup):
             cs = Rotation2D.identity()._data if rotation is None else rotation._data
             self._data = namespace_of(cs).concat([cs, cs * 0.0], axis=-1)
             return
-        t = as_array(translation, (2,), "translation")
-        check_finite(t, (2,), "translation")
+        t = finite_array(translation, (2,), "translation")
         xp = namespace_of(t)
         if rotation is None:
             zero = t[..., :1] * 0.0
@@ -105,8 +104,7 @@ class Transform2D(BatchedArray, LieGroup):
 
         ``R = exp(ω J)``, ``t = V(ω) v`` (see :func:`rigidkit.se2.exp`).
         """
-        xi = as_array(tau, (3,), "se(2) twist")
-        check_finite(xi, (3,), "se(2) twist")
+        xi = finite_array(tau, (3,), "se(2) twist")
         return cls._wrap(_k.pose_from_twist(xi))
 
     @classmethod
