@@ -16,9 +16,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import rigidkit as rk
-from rigidkit.group import LieGroup
 from rigidkit.kernels import se2 as k_se2
 from rigidkit.kernels import so2 as k_so2
+from rigidkit.objects.group import LieGroup
 
 GROUPS = [rk.Rotation2D, rk.Transform2D]
 HAT = {rk.Rotation2D: rk.so2.hat, rk.Transform2D: rk.se2.hat}

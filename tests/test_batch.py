@@ -1,4 +1,4 @@
-"""The container protocol (rigidkit._batch.BatchedArray), once for every class.
+"""The container protocol (rigidkit.objects._batch.BatchedArray), once for every class.
 
 Reference: NumPy indexing, reshaping and concatenation of the elements' matrices
 (or, for Quaternion, of its 4 components), which the classes must commute with.

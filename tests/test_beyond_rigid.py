@@ -25,9 +25,9 @@ from scipy.spatial.transform import Rotation as SciRot
 from scipy.special import exprel as sc_exprel
 
 import rigidkit as rk
-from rigidkit.group import LieGroup
 from rigidkit.kernels.coefficients import exprel
 from rigidkit.kernels.sim3 import sim3_v_coeffs
+from rigidkit.objects.group import LieGroup
 
 EPS = np.finfo(np.float64).eps
 
@@ -93,7 +93,7 @@ def assert_inverse_close(got, M):
 
 
 def homog(X):
-    return rk.projective.homogeneous_matrix(X)
+    return rk.objects.projective.homogeneous_matrix(X)
 
 
 # -- Sim(3): coefficients -------------------------------------------------------------

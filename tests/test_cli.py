@@ -22,9 +22,8 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from scipy.spatial.transform import Rotation as SciRot
-
 from rigidkit.cli import ALL, main
+from scipy.spatial.transform import Rotation as SciRot
 
 # Unit-free numbers (quaternions, matrices, MRPs, axes): a few ulp of float64
 # from two independent float64 implementations of the same conversion.
@@ -581,6 +580,7 @@ def test_an_error_naming_no_batch_index_is_located_by_bisection(
     tmp_path, capsys, monkeypatch
 ):
     import rigidkit.cli as cli
+
     from rigidkit.errors import RigidkitError
 
     real = cli.Rotation.from_mrp

@@ -1,6 +1,6 @@
 """The group axioms and Lie-group identities, once for every group class.
 
-Every entry of ``GROUPS`` is a class implementing :class:`rigidkit.group.LieGroup`
+Every entry of ``GROUPS`` is a class implementing :class:`rigidkit.objects.group.LieGroup`
 with its functional module (``hat``, ``vee``, ``bracket``); adding a group is one
 line. References are independent of the code under test: ``scipy.linalg.expm`` of
 the hat matrix, NumPy matrix products and inverses of ``as_matrix()``, the

@@ -533,7 +533,7 @@ def test_container_protocol_and_pickle(rng):
         "Transform(rotation=Rotation.from_quat([1, 0, 0, 0]), translation=[0, 0, 0])"
     )
     assert repr(T) == "Transform(shape=(3, 4), dtype=float64)"
-    assert isinstance(T, rk.group.LieGroup)
+    assert isinstance(T, rk.objects.group.LieGroup)
     assert (T.dof, T.matrix_size, T.point_dim) == (6, 4, 3)
 
 

@@ -6,7 +6,6 @@ Euler UPPER = intrinsic, lower = extrinsic; twists ``(v, omega)``; radians unles
 ``degrees=True``.
 """
 
-from . import conversions, se3, so3
 from .errors import (
     EulerSequenceError,
     GimbalLockWarning,
@@ -21,25 +20,82 @@ from .errors import (
     SingularMatrixError,
     ZeroNormError,
 )
-from .rotation import Rotation
-from .transform import Transform
+from .functional import conversions, se3, so3
+from .objects.rotation import Rotation
+from .objects.transform import Transform
 
 # The rest loads on first use, which keeps ``import rigidkit`` fast (the issue's
 # budget is 150 ms with NumPy; SymPy alone would take seconds).
 _LAZY = {
-    "Rotation2D": ("rotation2d", "Rotation2D"),
-    "Transform2D": ("transform2d", "Transform2D"),
-    "Similarity": ("similarity", "Similarity"),
-    "Affine": ("affine", "Affine"),
-    "Projective": ("projective", "Projective"),
-    "Quaternion": ("quaternion", "Quaternion"),
-    "euler": ("euler", None),
-    "quaternion": ("quaternion", None),
-    "so2": ("so2", None),
-    "se2": ("se2", None),
-    "sim3": ("sim3", None),
-    "symbolic": ("symbolic", None),
+    "Rotation2D": ("objects.rotation2d", "Rotation2D"),
+    "Transform2D": ("objects.transform2d", "Transform2D"),
+    "Similarity": ("objects.similarity", "Similarity"),
+    "Affine": ("objects.affine", "Affine"),
+    "Projective": ("objects.projective", "Projective"),
+    "Quaternion": ("objects.quaternion", "Quaternion"),
+    "euler": ("functional.euler", None),
+    "quaternion": ("functional.quaternion", None),
+    "so2": ("functional.so2", None),
+    "se2": ("functional.se2", None),
+    "sim3": ("functional.sim3", None),
+    "symbolic": ("applications.symbolic", None),
 }
+
+# The public module paths predate the layered tree (docs/architecture.md):
+# ``import rigidkit.so3`` keeps working and is the same module object as
+# ``rigidkit.functional.so3``.
+_MODULE_ALIASES = {
+    **{
+        name: f"functional.{name}"
+        for name in (
+            "conversions",
+            "euler",
+            "quaternion",
+            "so3",
+            "se3",
+            "so2",
+            "se2",
+            "sim3",
+        )
+    },
+    "symbolic": "applications.symbolic",
+    "cli": "applications.cli",
+}
+
+
+class _AliasFinder:
+    """Resolve ``rigidkit.<public name>`` to the module in its layer folder."""
+
+    @staticmethod
+    def find_spec(fullname, path=None, target=None):
+        prefix, _, leaf = fullname.rpartition(".")
+        if prefix != __name__ or leaf not in _MODULE_ALIASES:
+            return None
+        import importlib.util
+
+        return importlib.util.spec_from_loader(fullname, _AliasFinder)
+
+    @staticmethod
+    def create_module(spec):
+        import importlib
+
+        leaf = spec.name.rpartition(".")[2]
+        module = importlib.import_module(f"{__name__}.{_MODULE_ALIASES[leaf]}")
+        _REAL_SPECS[module.__name__] = module.__spec__
+        return module
+
+    @staticmethod
+    def exec_module(module):
+        # The import system stamped the alias spec on the real module: undo that.
+        module.__spec__ = _REAL_SPECS[module.__name__]
+
+
+_REAL_SPECS = {}
+
+
+import sys as _sys  # noqa: E402
+
+_sys.meta_path.append(_AliasFinder)
 
 __version__ = "0.1.0"
 

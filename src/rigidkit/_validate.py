@@ -75,3 +75,17 @@ def finite_array(x, trail: tuple, what: str):
     x = as_array(x, trail, what)
     check_finite(x, trail, what)
     return x
+
+
+def as_float(a):
+    """Integer NumPy input becomes float64; other arrays are kept."""
+    if isinstance(a, np.ndarray) and a.dtype.kind != "f":
+        return a.astype(np.float64)
+    return a
+
+
+def any_true(mask) -> bool:
+    """Whether any entry of a boolean array (of any namespace) is true."""
+    if isinstance(mask, (np.ndarray, np.bool_)):
+        return bool(mask.any())
+    return bool(namespace_of(mask).any(mask))

@@ -25,11 +25,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._engine.namespace import namespace_of
-from ._validate import as_array, batch_index, finite_array, where_text
+from .._engine.namespace import namespace_of
+from .._validate import as_array, batch_index, finite_array, where_text
+from ..errors import NotARigidTransformError
+from ..kernels import se2 as _k
 from .conversions import default_atol
-from .errors import NotARigidTransformError
-from .kernels import se2 as _k
 from .so2 import check_rotation_block
 
 __all__ = [

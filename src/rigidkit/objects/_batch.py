@@ -17,8 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._engine.namespace import namespace_of
-from .errors import ShapeError
+from .._engine.namespace import namespace_of
+from ..errors import ShapeError
 
 __all__ = ["BatchedArray", "batch_shape"]
 

@@ -1,20 +1,12 @@
-"""The quaternion algebra ``H``: general (not necessarily unit) quaternions.
+"""General quaternions as objects: :class:`Quaternion` holds one array of shape (..., 4).
 
-Components ``(w, x, y, z)`` = ``w + x i + y j + z k``, scalar first; Hamilton
-convention ``i^2 = j^2 = k^2 = ijk = -1`` (so ``ij = k``). Rotations use only unit
-quaternions (:class:`rigidkit.Rotation`); this module is the whole algebra: sums,
-the Hamilton product, conjugate, norm, inverse ``q* / |q|^2``, ``exp`` and ``log``,
-and the 4x4 matrices of left and right multiplication.
-
-The functions take and return arrays of shape (..., 4), batched over leading axes
-(broadcasting like NumPy), in the array namespace and dtype of their input;
-:class:`Quaternion` wraps one such array.
-
-Operators of :class:`Quaternion`, one meaning each: ``+`` and ``-`` add,
-``*`` is the Hamilton product (or, with a real scalar, scalar multiplication),
-``/`` divides by a real scalar only. ``@`` is not defined: in rigidkit ``@``
-means composing transforms or acting on points, and a general quaternion is
-neither; rotate points with :meth:`Quaternion.rotate` or ``q.to_rotation() @ p``.
+The algebra itself (Hamilton product, conjugate, inverse ``q* / |q|^2``, exp, log) is
+the functional module :mod:`rigidkit.functional.quaternion`; this class gives it
+operators, one meaning each: ``+`` and ``-`` add, ``*`` is the Hamilton product (or,
+with a real scalar, scalar multiplication), ``/`` divides by a real scalar only.
+``@`` is not defined: in rigidkit ``@`` means composing transforms or acting on
+points, and a general quaternion is neither; rotate points with
+:meth:`Quaternion.rotate` or ``q.to_rotation() @ p``.
 
 >>> import numpy as np
 >>> i = Quaternion([0.0, 1.0, 0.0, 0.0])
@@ -29,163 +21,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import conversions as _conv
+from .._engine.namespace import is_numpy, namespace_of
+from .._validate import _to_numpy, as_array, check_finite
+from ..functional import quaternion as _fq
 from ._batch import BatchedArray
-from ._engine.namespace import is_numpy, namespace_of
-from ._validate import _to_numpy, as_array, batch_index, check_finite, where_text
-from .errors import ZeroNormError
-from .kernels import quaternion as _kq
-from .kernels import quaternion_algebra as _ka
-from .projective import any_true
-
-__all__ = [
-    "Quaternion",
-    "multiply",
-    "conjugate",
-    "norm",
-    "inv",
-    "exp",
-    "log",
-    "left_matrix",
-    "right_matrix",
-    "rotate",
-]
-
-
-def _quat(q, what="quaternion"):
-    """``q`` as a float array of shape (..., 4) of its own namespace."""
-    q = as_array(q, (4,), what)
-    if isinstance(q, np.ndarray) and q.dtype.kind != "f":
-        q = q.astype(np.float64)
-    return q
-
-
-def _reject_zero(result, largest, what):
-    """``result``, unless ``largest`` (the largest |component|) is 0 somewhere."""
-    zero = largest == 0.0
-    if any_true(zero):
-        where = where_text(batch_index(zero))
-        raise ZeroNormError(f"{what} is the zero quaternion {where}")
-    return result
-
-
-def multiply(q1, q2):
-    """Hamilton product ``q1 q2``, shapes (..., 4) broadcasting.
-
-    ``q1 q2 = (w1 w2 - v1.v2, w1 v2 + w2 v1 + v1 x v2)``; not commutative.
-
-    >>> multiply([0.0, 0.0, 1.0, 0.0], [0.0, 1.0, 0.0, 0.0])   # ji = -k
-    array([ 0.,  0.,  0., -1.])
-    """
-    return _kq.quat_multiply(_quat(q1), _quat(q2))
-
-
-def conjugate(q):
-    """Conjugate ``q* = (w, -v)``, shape (..., 4); ``(q1 q2)* = q2* q1*``."""
-    return _kq.quat_conjugate(_quat(q))
-
-
-def norm(q):
-    """Euclidean norm ``|q| = sqrt(w^2 + |v|^2)``, shape (...), without overflow.
-
-    ``|q1 q2| = |q1| |q2|``.
-    """
-    return _kq.quat_normalize(_quat(q))[1]
-
-
-def inv(q):
-    """Multiplicative inverse ``q^-1 = q* / |q|^2``, shape (..., 4).
-
-    (The notes write ``q* / |q|``, which is wrong unless ``|q| = 1``.)
-    ``q q^-1 = q^-1 q = 1``.
-
-    Raises
-    ------
-    ZeroNormError
-        For a zero quaternion, naming its batch index.
-
-    >>> inv([0.0, 2.0, 0.0, 0.0])                 # (2i)^-1 = -i/2
-    array([ 0. , -0.5, -0. , -0. ])
-    """
-    return _reject_zero(*_ka.quat_inverse(_quat(q)), "inverse of a quaternion")
-
-
-def exp(q):
-    """Exponential ``exp(w + v) = e^w (cos|v|, sin(|v|) v / |v|)``, shape (..., 4).
-
-    Defined for every quaternion (the series ``sum q^n / n!``); exact for tiny
-    ``|v|`` (``sinc`` series). ``exp(q1 + q2) = exp(q1) exp(q2)`` only when ``q1`` and
-    ``q2`` commute. For a pure ``q = (0, theta/2 u)`` it is the unit quaternion
-    of the rotation by ``theta`` about ``u``.
-
-    >>> np.round(exp([0.0, 0.0, 0.0, np.pi / 2]), 12) + 0.0   # e^(k pi/2) = k
-    array([0., 0., 0., 1.])
-
-    See Also
-    --------
-    log
-    """
-    q = _quat(q)
-    check_finite(q, (4,), "quaternion")
-    return _ka.quat_exp(q)
-
-
-def log(q):
-    """Principal logarithm ``(log|q|, theta v / |v|)``, ``theta = atan2(|v|, w)``.
-
-    ``theta`` is in [0, pi], so ``exp(log(q)) = q`` for every nonzero ``q`` and
-    ``log(exp(p)) = p`` when ``|vector(p)| < pi``. On the negative real axis
-    (``v = 0``, ``w < 0``) the logarithm is not unique (``log|w| + pi u`` for any
-    unit ``u``); we return ``(log|w|, pi, 0, 0)``, i.e. ``u = i``.
-
-    Raises
-    ------
-    ZeroNormError
-        For a zero quaternion (log 0 is undefined), naming its batch index.
-
-    >>> np.round(log([-1.0, 0.0, 0.0, 0.0]), 12) + 0.0           # log(-1) = i pi
-    array([0.        , 3.14159265, 0.        , 0.        ])
-
-    See Also
-    --------
-    exp
-    """
-    q = _quat(q)
-    check_finite(q, (4,), "quaternion")
-    return _reject_zero(*_ka.quat_log(q), "logarithm of a quaternion")
-
-
-def left_matrix(q):
-    """``q+``, shape (..., 4, 4), with ``q p == q+ @ p`` for 4-vectors ``p``.
-
-    ``q+ = [[w, -v^T], [v, w I + hat(v)]]`` (left multiplication by ``q``).
-    ``q -> q+`` is an algebra homomorphism: ``(q1 q2)+ = q1+ q2+``.
-    """
-    return _ka.quat_left_matrix(_quat(q))
-
-
-def right_matrix(q):
-    """``q(+)``, shape (..., 4, 4), with ``p q == q(+) @ p`` for 4-vectors ``p``.
-
-    ``q(+) = [[w, -v^T], [v, w I - hat(v)]]`` (right multiplication by ``q``).
-    """
-    return _ka.quat_right_matrix(_quat(q))
-
-
-def rotate(q, points):
-    """``q p q^-1`` for 3-vectors ``p`` (as pure quaternions), shape (..., 3).
-
-    Works for any nonzero ``q``: the scale of ``q`` cancels, so this is the
-    rotation by ``q / |q|`` (active, Hamilton; :meth:`rigidkit.Rotation.apply`).
-
-    Raises
-    ------
-    ZeroNormError
-        For a zero quaternion.
-    """
-    unit = _conv.quat_normalize(_quat(q), what="quaternion")
-    p = as_array(points, (3,), "points")
-    return _kq.quat_apply(unit, p)
+from .rotation import Rotation
 
 
 class Quaternion(BatchedArray):
@@ -222,7 +62,7 @@ class Quaternion(BatchedArray):
     __array_ufunc__ = None
 
     def __init__(self, components):
-        q = _quat(components, "quaternion components")
+        q = _fq._quat(components, "quaternion components")
         check_finite(q, (4,), "quaternion components")
         self._q = q
 
@@ -263,8 +103,6 @@ class Quaternion(BatchedArray):
         ZeroNormError
             For a zero quaternion, naming its batch index.
         """
-        from .rotation import Rotation
-
         return Rotation.from_quat(self._q)
 
     # -- components ---------------------------------------------------------------
@@ -320,7 +158,7 @@ class Quaternion(BatchedArray):
 
     def __mul__(self, other):
         if isinstance(other, Quaternion):
-            return Quaternion._wrap(_kq.quat_multiply(self._q, other._q))
+            return Quaternion._wrap(_fq.multiply(self._q, other._q))
         s = self._scalar(other)
         return NotImplemented if s is None else Quaternion._wrap(self._q * s)
 
@@ -368,36 +206,35 @@ class Quaternion(BatchedArray):
 
     def conjugate(self):
         """``q* = (w, -v)``."""
-        return Quaternion._wrap(_kq.quat_conjugate(self._q))
+        return Quaternion._wrap(_fq.conjugate(self._q))
 
     def norm(self):
         """``|q|``, shape (...)."""
-        return _kq.quat_normalize(self._q)[1]
+        return _fq.norm(self._q)
 
     def inv(self):
         """``q^-1 = q* / |q|^2`` (raises :class:`~rigidkit.ZeroNormError` for 0)."""
-        return Quaternion._wrap(inv(self._q))
+        return Quaternion._wrap(_fq.inv(self._q))
 
     def exp(self):
-        """``exp(q)``; see :func:`rigidkit.quaternion.exp`."""
-        return Quaternion._wrap(_ka.quat_exp(self._q))
+        """``exp(q)``; see :func:`rigidkit.functional.quaternion.exp`."""
+        return Quaternion._wrap(_fq.exp(self._q))
 
     def log(self):
-        """Principal ``log(q)``; see :func:`rigidkit.quaternion.log`."""
-        log_q = _reject_zero(*_ka.quat_log(self._q), "logarithm of a quaternion")
-        return Quaternion._wrap(log_q)
+        """Principal ``log(q)``; see :func:`rigidkit.functional.quaternion.log`."""
+        return Quaternion._wrap(_fq.log(self._q))
 
     def left_matrix(self):
         """``q+`` (..., 4, 4) with ``(q * p) == q.left_matrix() @ p`` as 4-vectors."""
-        return _ka.quat_left_matrix(self._q)
+        return _fq.left_matrix(self._q)
 
     def right_matrix(self):
         """``q(+)`` (..., 4, 4) with ``(p * q) == q.right_matrix() @ p`` as 4-vectors."""
-        return _ka.quat_right_matrix(self._q)
+        return _fq.right_matrix(self._q)
 
     def rotate(self, points):
-        """``q p q^-1`` for points ``p`` (..., 3), any nonzero ``q``; see :func:`rotate`."""
-        return rotate(self._q, points)
+        """``q p q^-1`` for points ``p`` (..., 3), any nonzero ``q``."""
+        return _fq.rotate(self._q, points)
 
     def approx_equal(self, other, *, atol=1e-12, rtol=0.0):
         """``|q_i - o_i| <= atol + rtol |o_i|`` for all four components; shape (...).

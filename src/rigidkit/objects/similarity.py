@@ -16,17 +16,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import conversions as _conv
+from .._engine.namespace import device_of, namespace_of
+from .._validate import _to_numpy, as_array, as_float, batch_index, check_finite, where_text
+from ..errors import NotASimilarityError
+from ..functional import conversions as _conv
+from ..functional import sim3 as _fsim3
+from ..kernels import sim3 as _k
 from ._batch import BatchedArray, batch_shape
-from ._engine.namespace import device_of, namespace_of
-from ._validate import _to_numpy, as_array, batch_index, check_finite, where_text
-from .errors import NotASimilarityError
 from .group import LieGroup
-from .kernels import matrix as _kmat
-from .kernels import sim3 as _k
-from .projective import _as_float, _include_check, _LadderMember, _rank
+from .projective import _include_check, _LadderMember, _rank
 from .rotation import Rotation
-from .se3 import check_bottom_row
 from .transform import pose_gap
 
 __all__ = ["Similarity", "NotASimilarityError"]
@@ -76,12 +75,12 @@ class Similarity(BatchedArray, _LadderMember, LieGroup):
         q = None if rotation is None else rotation.as_quat()
         t = None
         if translation is not None:
-            t = _as_float(as_array(translation, (3,), "translation"))
+            t = as_float(as_array(translation, (3,), "translation"))
             check_finite(t, (3,), "translation")
         s = None
         if scale is not None:
             s = scale if isinstance(scale, (int, float)) else as_array(scale, (), "scale")
-            s = _as_float(s) if not isinstance(s, (int, float)) else s
+            s = as_float(s) if not isinstance(s, (int, float)) else s
             check_finite(s, (), "scale")
             _check_positive(s)
         self._data = _assemble(q, t, s)
@@ -108,28 +107,7 @@ class Similarity(BatchedArray, _LadderMember, LieGroup):
             positive scalar times a rotation (zero, a reflection, a non-uniform
             scaling, a shear); the message names the first batch index and why.
         """
-        M = _as_float(as_array(matrix, (4, 4), "homogeneous matrix"))
-        check_finite(M, (4, 4), "homogeneous matrix")
-        check_bottom_row(M, atol, "a similarity transform", NotASimilarityError)
-        xp = namespace_of(M)
-        A = M[..., :3, :3]
-        s = xp.sqrt(xp.sum(A * A, axis=(-2, -1)) / 3.0)
-        zero = s == 0.0
-        if bool(xp.any(zero)):
-            raise NotASimilarityError(
-                f"3x3 block of the homogeneous matrix {where_text(batch_index(zero))} is "
-                "zero; a similarity needs a positive scale"
-            )
-        q, err = _kmat.quat_from_matrix(A / s[..., None, None])
-        tol = _conv.default_atol(q.dtype) if atol is None else atol
-        bad = err > tol
-        if bool(xp.any(bad)):
-            idx = batch_index(bad)
-            raise NotASimilarityError(
-                f"3x3 block of the homogeneous matrix {where_text(idx)} is not a positive "
-                f"scalar times a rotation: {_why(A, idx)} (tolerance {tol:g})"
-            )
-        return cls._wrap(xp.concat([q, M[..., :3, 3], s[..., None]], axis=-1))
+        return cls._wrap(_fsim3.pose_from_matrix(matrix, atol=atol))
 
     @classmethod
     def from_transform(cls, transform):
@@ -171,7 +149,7 @@ class Similarity(BatchedArray, _LadderMember, LieGroup):
         >>> float(S.scale), np.round(S.translation, 12) + 0.0   # t = (2 - 1)/log 2 v
         (2.0, array([1.44269504, 0.        , 0.        ]))
         """
-        xi = _as_float(as_array(tau, (7,), "sim(3) twist"))
+        xi = as_float(as_array(tau, (7,), "sim(3) twist"))
         check_finite(xi, (7,), "sim(3) twist")
         return cls._wrap(_k.sim3_exp(xi))
 
@@ -315,12 +293,3 @@ def _assemble(q, t, s):
         ],
         axis=-1,
     )
-
-
-def _why(A, idx) -> str:
-    a = np.asarray(_to_numpy(A)[idx], dtype=np.float64)
-    det = float(np.linalg.det(a))
-    sv = np.linalg.svd(a, compute_uv=False)
-    if det < 0:
-        return f"det = {det:.6g} < 0 (a reflection)"
-    return f"singular values {np.round(sv, 6).tolist()} are not all equal"

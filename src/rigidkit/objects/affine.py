@@ -3,7 +3,7 @@
 The homogeneous matrix is ``[[A, t], [0, 1]]`` with ``A`` any invertible 3x3 matrix
 (rotations, scalings, shears, reflections). It sits between
 :class:`~rigidkit.Similarity` and :class:`~rigidkit.Projective` on the ladder of
-kinds (see :mod:`rigidkit.projective`): composing with a lower kind gives an
+kinds (see :mod:`rigidkit.objects.projective`): composing with a lower kind gives an
 ``Affine``, with a ``Projective`` a ``Projective``.
 """
 
@@ -11,21 +11,20 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._engine.namespace import device_of, namespace_of
+from .._validate import _to_numpy, as_array, as_float, check_finite
+from ..errors import NotAffineError
+from ..functional.se3 import check_bottom_row
+from ..kernels import homogeneous as _k
 from ._batch import BatchedArray, batch_shape
-from ._engine.namespace import device_of, namespace_of
-from ._validate import _to_numpy, as_array, check_finite
-from .errors import NotAffineError
-from .kernels import homogeneous as _k
 from .projective import (
     Projective,
-    _as_float,
     _include_check,
     _LadderMember,
     check_invertible,
     homogeneous_matrix,
     singular_rtol,
 )
-from .se3 import check_bottom_row
 
 __all__ = ["Affine", "NotAffineError"]
 
@@ -46,7 +45,7 @@ class Affine(BatchedArray, _LadderMember):
         ``t`` (zero when omitted). Batch shapes broadcast.
     rtol : float, optional
         Default 1e-12 (float64) or 1e-5 (float32), see
-        :func:`rigidkit.projective.singular_rtol`.
+        :func:`rigidkit.objects.projective.singular_rtol`.
 
     Examples
     --------
@@ -65,12 +64,12 @@ class Affine(BatchedArray, _LadderMember):
         A = (
             None
             if matrix is None
-            else _as_float(as_array(matrix, (3, 3), "affine matrix A"))
+            else as_float(as_array(matrix, (3, 3), "affine matrix A"))
         )
         t = (
             None
             if translation is None
-            else _as_float(as_array(translation, (3,), "translation"))
+            else as_float(as_array(translation, (3,), "translation"))
         )
         if A is None and t is None:
             A = np.eye(3)
@@ -114,7 +113,7 @@ class Affine(BatchedArray, _LadderMember):
         SingularMatrixError
             ``A`` is singular (see the class docs), naming the batch index.
         """
-        M = _as_float(as_array(matrix, (4, 4), "homogeneous matrix"))
+        M = as_float(as_array(matrix, (4, 4), "homogeneous matrix"))
         check_finite(M, (4, 4), "homogeneous matrix")
         check_bottom_row(M, atol, "an affine transform", NotAffineError)
         return cls(matrix=M[..., :3, :3], translation=M[..., :3, 3], rtol=rtol)

@@ -19,14 +19,14 @@ import math
 
 import numpy as np
 
-from ._engine.namespace import is_float32, is_numpy, namespace_of
-from ._validate import as_array, batch_index, check_finite, finite_array, where_text
-from .errors import NotARotationError, ZeroNormError
-from .kernels import axis_angle as _aa
-from .kernels import matrix as _mat
-from .kernels import mrp as _mrp
-from .kernels import quaternion as _q
-from .kernels import rotvec as _rv
+from .._engine.namespace import is_float32, is_numpy, namespace_of
+from .._validate import as_array, batch_index, check_finite, finite_array, where_text
+from ..errors import NotARotationError, ZeroNormError
+from ..kernels import axis_angle as _aa
+from ..kernels import matrix as _mat
+from ..kernels import mrp as _mrp
+from ..kernels import quaternion as _q
+from ..kernels import rotvec as _rv
 
 __all__ = [
     "quat_normalize",

@@ -10,12 +10,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import se2 as _se2
+from .._engine.namespace import float_dtype_of, namespace_of
+from .._validate import _to_numpy, as_array, finite_array
+from ..functional import se2 as _se2
+from ..kernels import se2 as _k
 from ._batch import BatchedArray, batch_shape
-from ._engine.namespace import float_dtype_of, namespace_of
-from ._validate import _to_numpy, as_array, finite_array
 from .group import LieGroup
-from .kernels import se2 as _k
 from .rotation2d import Rotation2D
 
 __all__ = ["Transform2D"]

@@ -19,11 +19,19 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._engine.namespace import device_of, is_float32, namespace_of
+from .._validate import (
+    _to_numpy,
+    any_true,
+    as_array,
+    as_float,
+    batch_index,
+    check_finite,
+    where_text,
+)
+from ..errors import PointAtInfinityError, SingularMatrixError
+from ..kernels import homogeneous as _k
 from ._batch import BatchedArray, batch_shape
-from ._engine.namespace import device_of, is_float32, namespace_of
-from ._validate import _to_numpy, as_array, batch_index, check_finite, where_text
-from .errors import PointAtInfinityError, SingularMatrixError
-from .kernels import homogeneous as _k
 
 __all__ = [
     "Projective",
@@ -153,13 +161,6 @@ _INF_RTOL_32 = 64.0 * float(np.finfo(np.float32).eps)
 _INF_RTOL_64 = 64.0 * float(np.finfo(np.float64).eps)
 
 
-def any_true(mask) -> bool:
-    """Whether any entry of a boolean array (of any namespace) is true."""
-    if isinstance(mask, (np.ndarray, np.bool_)):
-        return bool(mask.any())
-    return bool(namespace_of(mask).any(mask))
-
-
 def check_invertible(ratio, rtol, what):
     """Raise :class:`SingularMatrixError` where the Hadamard ``ratio`` is <= ``rtol``."""
     bad = ratio <= rtol
@@ -211,7 +212,7 @@ class Projective(BatchedArray, _LadderMember):
     _trail = (4, 4)
 
     def __init__(self, matrix, *, rtol=None):
-        H = _as_float(as_array(matrix, (4, 4), "projective matrix"))
+        H = as_float(as_array(matrix, (4, 4), "projective matrix"))
         check_finite(H, (4, 4), "projective matrix")
         tol = singular_rtol(H.dtype) if rtol is None else rtol
         check_invertible(_k.projective_hadamard_ratio(H), tol, "projective matrix")
@@ -320,10 +321,3 @@ class Projective(BatchedArray, _LadderMember):
     # -- container protocol (shape, len, [], reshape, ...): BatchedArray ------------------
     def _repr_single(self):
         return f"Projective({_to_numpy(self._data).tolist()!r})"
-
-
-def _as_float(a):
-    """Integer NumPy input becomes float64; other arrays are kept."""
-    if isinstance(a, np.ndarray) and a.dtype.kind != "f":
-        return a.astype(np.float64)
-    return a

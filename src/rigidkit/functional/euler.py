@@ -49,11 +49,11 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .._engine.namespace import is_float32, namespace_of
+from .._validate import batch_index, finite_array, where_text
+from ..errors import EulerSequenceError, GimbalLockWarning
+from ..kernels import euler as _k
 from . import conversions as _conv
-from ._engine.namespace import is_float32, namespace_of
-from ._validate import batch_index, finite_array, where_text
-from .errors import EulerSequenceError, GimbalLockWarning
-from .kernels import euler as _k
 
 __all__ = [
     "EulerSequence",
@@ -414,7 +414,7 @@ def _host(a):
     return a.detach().cpu().numpy() if hasattr(a, "detach") else np.asarray(a)
 
 
-_PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))
+_PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
 def _user_stacklevel() -> int:

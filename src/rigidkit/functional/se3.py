@@ -31,17 +31,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import conversions as _conv
-from ._engine.namespace import namespace_of
-from ._validate import (
+from .._engine.namespace import namespace_of
+from .._validate import (
     _to_numpy,
     as_array,
     batch_index,
     finite_array,
     where_text,
 )
-from .errors import NotARigidTransformError, NotARotationError
-from .kernels import se3 as _k
+from ..errors import NotARigidTransformError, NotARotationError
+from ..kernels import se3 as _k
+from . import conversions as _conv
 
 __all__ = [
     "hat",

@@ -13,13 +13,13 @@ import math
 
 import numpy as np
 
-from . import so2 as _so2
+from .._engine.namespace import is_numpy, is_torch, namespace_of
+from .._validate import _to_numpy, as_array, check_finite, finite_array
+from ..errors import ShapeError
+from ..functional import so2 as _so2
+from ..kernels import so2 as _k
 from ._batch import BatchedArray, batch_shape
-from ._engine.namespace import is_numpy, is_torch, namespace_of
-from ._validate import _to_numpy, as_array, check_finite, finite_array
-from .errors import ShapeError
 from .group import LieGroup
-from .kernels import so2 as _k
 
 __all__ = ["Rotation2D"]
 

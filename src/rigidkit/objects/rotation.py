@@ -12,10 +12,10 @@ import math
 
 import numpy as np
 
-from . import conversions as _conv
-from . import euler
+from .._validate import _to_numpy, as_array
+from ..functional import conversions as _conv
+from ..functional import euler
 from ._batch import BatchedArray, batch_shape
-from ._validate import _to_numpy, as_array
 from .group import LieGroup
 
 __all__ = ["Rotation"]

@@ -35,9 +35,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import __version__
-from .errors import GimbalLockWarning, RigidkitError
-from .rotation import Rotation
+from .. import __version__
+from ..errors import GimbalLockWarning, RigidkitError
+from ..objects.rotation import Rotation
 
 __all__ = ["main"]
 
@@ -166,7 +166,7 @@ def representation(name: str) -> Representation:
         return _FIXED[name]
     if name.startswith("euler:"):
         seq = name[len("euler:") :]
-        from .euler import parse_sequence
+        from ..functional.euler import parse_sequence
 
         try:
             # The library's parser is the one source of truth for the 24 accepted

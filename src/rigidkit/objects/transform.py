@@ -10,13 +10,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import conversions as _conv
-from . import se3 as _se3
+from .._engine.namespace import device_of, namespace_of
+from .._validate import _to_numpy, as_array, finite_array
+from ..functional import conversions as _conv
+from ..functional import se3 as _se3
+from ..kernels import se3 as _k
 from ._batch import BatchedArray, batch_shape
-from ._engine.namespace import device_of, namespace_of
-from ._validate import _to_numpy, as_array, finite_array
 from .group import LieGroup
-from .kernels import se3 as _k
 from .rotation import Rotation
 
 __all__ = ["Transform"]

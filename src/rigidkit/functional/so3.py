@@ -12,10 +12,10 @@ True
 
 from __future__ import annotations
 
+from .._validate import as_array, finite_array
+from ..kernels import rotvec as _rv
+from ..kernels import so3 as _k
 from . import conversions as _conv
-from ._validate import as_array, finite_array
-from .kernels import rotvec as _rv
-from .kernels import so3 as _k
 
 __all__ = ["hat", "vee", "exp", "log"]
 
@@ -63,7 +63,7 @@ def log(R, *, atol=None):
 #   left:  exp(w + d) ~ exp(J_l(w) d) exp(w)     right: exp(w + d) ~ exp(w) exp(J_r(w) d)
 #   J_r(w) = J_l(-w) = J_l(w)^T.
 
-from .kernels import so3_jacobians as _jac  # noqa: E402
+from ..kernels import so3_jacobians as _jac  # noqa: E402
 
 __all__ += [
     "adjoint",

@@ -61,9 +61,9 @@ from fractions import Fraction
 
 import sympy as sp
 
-from . import kernels as _kernels_pkg
-from ._engine.kernel import _HELPERS, Helper, Kernel, _rebind
-from ._engine.primitives import sympy_bindings
+from .. import kernels as _kernels_pkg
+from .._engine.kernel import _HELPERS, Helper, Kernel, _rebind
+from .._engine.primitives import sympy_bindings
 
 #: Kernel modules whose names are top-level, first one first for shared names.
 _PREFERRED = (
