@@ -23,7 +23,32 @@ __all__ = [
 
 
 class RigidkitError(ValueError):
-    """Base class of every input error raised by rigidkit."""
+    """Base class of every input error raised by rigidkit.
+
+    Parameters
+    ----------
+    message : str
+        What was wrong and where, in words.
+    index : tuple of int, optional
+        The first offending batch index (``()`` for a single input), or ``None``
+        when the error is not about one element. Programs (the CLI, for one) read
+        this attribute instead of parsing the message.
+
+    >>> err = RigidkitError("quaternion at batch index (2,) is zero", index=(2,))
+    >>> err.index
+    (2,)
+    """
+
+    def __init__(self, message="", *, index=None):
+        super().__init__(message)
+        self.index = None if index is None else tuple(int(i) for i in index)
+
+    def __reduce__(self):
+        return (_rebuild_error, (type(self), str(self), self.index))
+
+
+def _rebuild_error(cls, message, index):
+    return cls(message, index=index)
 
 
 class NotARotationError(RigidkitError):
