@@ -547,7 +547,7 @@ def test_batch_argument_errors(extra, words, tmp_path, capsys):
 def test_a_failed_write_leaves_no_file_behind(
     out_name, failure, tmp_path, capsys, monkeypatch
 ):
-    import rigidkit.cli as cli
+    from rigidkit.applications.cli import command
 
     np.save(tmp_path / "in.npy", np.eye(4))
     (tmp_path / out_name).write_bytes(b"precious")
@@ -556,8 +556,8 @@ def test_a_failed_write_leaves_no_file_behind(
         stream.write(b"partial" if "b" in stream.mode else "partial")
         raise failure
 
-    monkeypatch.setattr(cli, "_write_csv", write_half_then_fail)
-    monkeypatch.setattr(cli.np, "save", write_half_then_fail)
+    monkeypatch.setattr(command, "write_csv", write_half_then_fail)
+    monkeypatch.setattr(np, "save", write_half_then_fail)
     argv = [
         "convert",
         "--from",
@@ -576,21 +576,31 @@ def test_a_failed_write_leaves_no_file_behind(
     assert sorted(os.listdir(tmp_path)) == sorted(["in.npy", out_name])
 
 
+def _picky_from_mrp(monkeypatch, error):
+    """Make ``Rotation.from_mrp`` raise ``error(p)`` when it returns an error."""
+    from rigidkit import Rotation
+
+    real = Rotation.from_mrp
+
+    def picky(p):
+        exc = error(np.asarray(p))
+        if exc is not None:
+            raise exc
+        return real(p)
+
+    monkeypatch.setattr(Rotation, "from_mrp", staticmethod(picky))
+
+
 def test_an_error_naming_no_batch_index_is_located_by_bisection(
     tmp_path, capsys, monkeypatch
 ):
-    import rigidkit.cli as cli
-
     from rigidkit.errors import RigidkitError
 
-    real = cli.Rotation.from_mrp
-
-    def picky(p):  # rejects any batch holding the (made-up) bad value 0.5
-        if np.any(np.asarray(p) == 0.5):
-            raise RigidkitError("this MRP is not welcome")
-        return real(p)
-
-    monkeypatch.setattr(cli.Rotation, "from_mrp", staticmethod(picky))
+    # Rejects any batch holding the (made-up) bad value 0.5, with no index.
+    _picky_from_mrp(
+        monkeypatch,
+        lambda p: RigidkitError("this MRP is not welcome") if np.any(p == 0.5) else None,
+    )
     a = np.zeros((2000, 3))
     a[1234, 2] = a[1500, 0] = 0.5
     np.save(tmp_path / "in.npy", a)
@@ -599,6 +609,54 @@ def test_an_error_naming_no_batch_index_is_located_by_bisection(
     assert code == 2
     where = f"{tmp_path / 'in.npy'} row 1235 (index 1234)"
     assert err == f"rigidkit: error: {where}: this MRP is not welcome\n"
+
+
+@pytest.mark.parametrize("suffix", [".npy", ".csv"])
+def test_the_row_named_comes_from_err_index(suffix, tmp_path, capsys, monkeypatch):
+    from rigidkit.errors import RigidkitError
+
+    # Every prefix of the batch fails, so bisection would blame the first row, and
+    # the message names another index: only err.index gives row 1235.
+    _picky_from_mrp(
+        monkeypatch,
+        lambda p: RigidkitError("MRP at batch index (1234,) is bad", index=(1234,)),
+    )
+    a = np.zeros((2000, 3))
+    path = tmp_path / f"in{suffix}"
+    if suffix == ".npy":
+        np.save(path, a)
+        where = f"{path} row 1235 (index 1234)"
+    else:
+        path.write_text("x,y,z\n# comment\n" + "0,0,0\n" * 2000)
+        where = f"{path} line 1237 (data row 1235)"
+    argv = ["convert", "--from", "mrp", "-i", path, "--to", "quat"]
+    code, _, err = run(argv + ["-o", tmp_path / "o.npy"], capsys)
+    assert (code, err) == (2, f"rigidkit: error: {where}: MRP is bad\n")
+    assert not (tmp_path / "o.npy").exists()
+
+
+def test_a_gimbal_lock_warning_carrying_its_index_is_placed_by_it(
+    tmp_path, capsys, monkeypatch
+):
+    import warnings
+
+    from rigidkit import GimbalLockWarning, Rotation
+
+    real = Rotation.as_euler
+
+    def as_euler(self, *args, **kwargs):
+        w = GimbalLockWarning("gimbal lock (made up)")
+        w.index = (2,)  # no row of this batch is locked: only the index says 2
+        warnings.warn(w, stacklevel=2)
+        return real(self, *args, **kwargs)
+
+    monkeypatch.setattr(Rotation, "as_euler", as_euler)
+    np.save(tmp_path / "in.npy", np.zeros((5, 3)))
+    argv = ["convert", "--from", "rotvec", "-i", tmp_path / "in.npy"]
+    code, out, err = run(argv + ["--to", "euler:ZYX", "-o", "-"], capsys)
+    assert code == 0 and len(out.splitlines()) == 6
+    where = f"{tmp_path / 'in.npy'} row 3 (index 2)"
+    assert err == f"rigidkit: warning: {where}: gimbal lock (made up)\n"
 
 
 # -- the two ways to run it from a shell -----------------------------------------------
