@@ -1,11 +1,24 @@
-"""Shared test settings: hypothesis profiles and small helpers used by several files.
+"""Shared test settings: hypothesis profiles, optional backends, small helpers.
 
 Hypothesis runs with ``deadline=None`` (a first call may wait for a numba compile)
 and a modest number of examples; ``HYPOTHESIS_PROFILE=thorough`` runs more.
+
+Optional backends (torch, JAX, Dask) are installed on some platforms only (torch's
+CPU wheel exists for Python 3.11 x86_64 here), so a test asks for one and is skipped
+alone when it is missing; every other test of the file still runs. Three spellings:
+
+* a fixture argument: ``def test_x(torch): ...`` (also ``jax``, ``jnp``, ``dask_array``);
+* a marker, for tests that reach the backend through module-level helpers:
+  ``@needs("torch")`` (``needs = pytest.mark.needs``);
+* a module-level import that never fails: ``torch = optional("torch")`` gives the
+  module or ``None``, for helpers and parametrisations that mention it.
+
+``pytest.importorskip`` at module level is not used: it skips every test of the file.
 """
 
 from __future__ import annotations
 
+import importlib
 import os
 
 import numpy as np
@@ -20,6 +33,54 @@ settings.register_profile(
 )
 settings.register_profile("thorough", max_examples=2000, deadline=None)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "default"))
+
+# Optional backends: the import name of each, by the name tests use for it.
+OPTIONAL = {
+    "torch": "torch",
+    "jax": "jax",
+    "jnp": "jax.numpy",
+    "dask_array": "dask.array",
+    "distributed": "distributed",
+}
+
+
+def optional(module: str):
+    """``module`` imported, or ``None`` where it is not installed."""
+    try:
+        return importlib.import_module(module)
+    except ImportError:
+        return None
+
+
+def pytest_configure(config):
+    config.addinivalue_line(
+        "markers", "needs(name, ...): skip this test unless each optional backend imports"
+    )
+
+
+def pytest_runtest_setup(item):
+    for mark in item.iter_markers("needs"):
+        for name in mark.args:
+            pytest.importorskip(OPTIONAL.get(name, name))
+
+
+def _backend_fixture(name: str):
+    def fixture():
+        module = pytest.importorskip(OPTIONAL[name])
+        if name in ("jax", "jnp"):
+            # float64 everywhere, as NumPy: tolerances are written for it.
+            importlib.import_module("jax").config.update("jax_enable_x64", True)
+        return module
+
+    fixture.__name__ = name
+    fixture.__doc__ = f"``{OPTIONAL[name]}``, or skip this test where it is not installed."
+    return pytest.fixture(name=name)(fixture)
+
+
+torch = _backend_fixture("torch")
+jax = _backend_fixture("jax")
+jnp = _backend_fixture("jnp")
+dask_array = _backend_fixture("dask_array")
 
 
 @pytest.fixture

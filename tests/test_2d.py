@@ -743,10 +743,9 @@ class TestTransform2DSurface:
 
 # ================================================================== torch ======
 class TestTorch:
-    torch = pytest.importorskip("torch")
-
-    def test_tensors_in_tensors_out(self):
-        torch = self.torch
+    # ``torch`` is the conftest fixture: these tests skip alone where it is missing
+    # (an importorskip in the class body would skip the whole module on import).
+    def test_tensors_in_tensors_out(self, torch):
         xi = torch.tensor([[0.3, -0.2, 1.0], [1.0, 2.0, -3.0]], dtype=torch.float64)
         T = rk.Transform2D.exp(xi)
         assert isinstance(T._data, torch.Tensor)
@@ -776,8 +775,7 @@ class TestTorch:
         with pytest.raises(rk.NotARotationError):
             rk.Transform2D.from_matrix(torch.zeros(3, 3, dtype=torch.float64))
 
-    def test_gradients(self):
-        torch = self.torch
+    def test_gradients(self, torch):
         for w in (0.0, 1e-9, 0.5, 3.0):
             xi = torch.tensor([0.4, -0.3, w], dtype=torch.float64, requires_grad=True)
             assert torch.autograd.gradcheck(lambda x: rk.Transform2D.exp(x).log(), (xi,))

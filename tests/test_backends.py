@@ -13,15 +13,15 @@ from __future__ import annotations
 
 import math
 
+import array_api_strict as xps
 import numpy as np
 import pytest
 
 import rigidkit as rk
 
-torch = pytest.importorskip("torch")
-xps = pytest.importorskip("array_api_strict")
-
-TORCH_DTYPES = pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
+# torch comes from the ``torch`` fixture (tests/conftest.py): only these tests skip
+# where it is not installed.
+TORCH_DTYPES = pytest.mark.parametrize("dtype_name", ["float32", "float64"])
 
 
 def _np(t):
@@ -69,7 +69,8 @@ def _constructors(make, q, xp_name):
 
 
 @TORCH_DTYPES
-def test_torch_in_torch_out(dtype):
+def test_torch_in_torch_out(torch, dtype_name):
+    dtype = getattr(torch, dtype_name)
     q = np.random.default_rng(0).standard_normal((6, 4))
     ref = rk.Rotation.from_quat(q)
     v = np.random.default_rng(1).standard_normal((6, 3))
@@ -94,7 +95,7 @@ def test_torch_in_torch_out(dtype):
             )
 
 
-def test_torch_single_rotation_and_mixed_inputs():
+def test_torch_single_rotation_and_mixed_inputs(torch):
     R = rk.Rotation.from_rotvec(torch.tensor([0.0, 0.0, math.pi / 2], dtype=torch.float64))
     assert R.shape == ()
     out = R @ torch.tensor([1.0, 0.0, 0.0], dtype=torch.float64)
@@ -112,7 +113,7 @@ def test_torch_single_rotation_and_mixed_inputs():
 
 
 # -- gradients -------------------------------------------------------------------------
-def _points():
+def _points(torch):
     v = np.random.default_rng(2).standard_normal((5, 3))
     return torch.tensor(v, dtype=torch.float64)
 
@@ -128,9 +129,9 @@ ROTVECS = {
 
 
 @pytest.mark.parametrize("case", list(ROTVECS))
-def test_gradcheck_from_rotvec_apply(case):
+def test_gradcheck_from_rotvec_apply(torch, case):
     r = torch.tensor(ROTVECS[case], dtype=torch.float64, requires_grad=True)
-    pts = _points()
+    pts = _points(torch)
     if r.ndim == 2:
         pts = pts[:3]
     assert torch.autograd.gradcheck(lambda r: rk.Rotation.from_rotvec(r).apply(pts), (r,))
@@ -150,9 +151,9 @@ QUATS = {
 
 
 @pytest.mark.parametrize("case", list(QUATS))
-def test_gradcheck_from_quat_apply(case):
+def test_gradcheck_from_quat_apply(torch, case):
     q = torch.tensor(QUATS[case], dtype=torch.float64, requires_grad=True)
-    pts = _points()[:3] if q.ndim == 2 else _points()
+    pts = _points(torch)[:3] if q.ndim == 2 else _points(torch)
     if q.ndim == 2:
         pts = pts[:, None, :]  # each of 3 rotations on each of 3 points -> (3, 3, 3)
     assert torch.autograd.gradcheck(lambda q: rk.Rotation.from_quat(q).apply(pts), (q,))
@@ -160,7 +161,7 @@ def test_gradcheck_from_quat_apply(case):
 
 
 @pytest.mark.parametrize("case", ["generic", "identity", "w < 0", "not unit", "small"])
-def test_gradcheck_as_rotvec(case):
+def test_gradcheck_as_rotvec(torch, case):
     """log has a derivative everywhere below pi, the identity included.
 
     (At pi, w = 0, it jumps from ``pi a`` to ``-pi a``: no derivative there.)
@@ -170,11 +171,11 @@ def test_gradcheck_as_rotvec(case):
     assert torch.autograd.gradcheck(lambda q: rk.Rotation.from_quat(q).as_rotvec(), (q,))
 
 
-def test_gradcheck_from_matrix_and_compose():
+def test_gradcheck_from_matrix_and_compose(torch):
     A = rk.Rotation.from_rotvec([0.3, -1.2, 0.8])
     m = torch.tensor(A.as_matrix(), dtype=torch.float64, requires_grad=True)
     q = torch.tensor([0.9, 0.1, -0.3, 0.2], dtype=torch.float64, requires_grad=True)
-    pts = _points()
+    pts = _points(torch)
 
     def f(m, q):
         # Finite differences step 1e-6 off SO(3): accept it (atol) for the check.
@@ -183,7 +184,7 @@ def test_gradcheck_from_matrix_and_compose():
     assert torch.autograd.gradcheck(f, (m, q))
 
 
-def test_gradient_at_identity_is_finite_and_right():
+def test_gradient_at_identity_is_finite_and_right(torch):
     """d/dr sum(exp(hat r) v) at r = 0 is sum(r x v)' = v x (1, 1, 1)."""
     r = torch.zeros(3, dtype=torch.float64, requires_grad=True)
     v = torch.tensor([1.0, 2.0, 3.0], dtype=torch.float64)

@@ -11,10 +11,12 @@ import numpy as np
 import pytest
 
 import rigidkit as rk
+from conftest import optional
 from rigidkit import conversions as C
 from rigidkit import errors
 
-torch = pytest.importorskip("torch")
+# torch or None: its tests are marked ``needs("torch")`` and skip alone without it.
+torch = optional("torch")
 
 
 def test_every_error_is_a_value_error():
@@ -65,6 +67,7 @@ def test_zero_quaternion():
     np.testing.assert_array_equal(R.as_quat(), [0.0, 1.0, 0.0, 0.0])
 
 
+@pytest.mark.needs("torch")
 def test_torch_quaternion_errors():
     q = torch.tensor(_batch_with_bad([1.0, 0, 0, 0], [np.nan, 0, 0, 0]))
     _raises(rk.NonFiniteError, lambda: rk.Rotation.from_quat(q), "(1, 2)")
@@ -123,7 +126,8 @@ def no_svd(monkeypatch):
         raise AssertionError("an SVD ran on input that should have been rejected")
 
     monkeypatch.setattr(np.linalg, "svd", svd)
-    monkeypatch.setattr(torch.linalg, "svd", svd)
+    if torch is not None:
+        monkeypatch.setattr(torch.linalg, "svd", svd)
 
 
 @pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
@@ -143,6 +147,13 @@ def test_non_finite_matrix_rejected_before_svd(bad, orthonormalize, no_svd):
         rk.NonFiniteError,
         lambda: rk.Rotation.from_matrix(full_inf, orthonormalize=orthonormalize),
     )
+
+
+@pytest.mark.needs("torch")
+@pytest.mark.parametrize("orthonormalize", [False, True])
+def test_non_finite_torch_matrix_rejected_before_svd(orthonormalize, no_svd):
+    m = _batch_with_bad(np.eye(3), np.eye(3))
+    m[1, 2, 0, 1] = np.nan
     t = torch.tensor(m)
     _raises(
         rk.NonFiniteError,
@@ -173,6 +184,13 @@ def test_not_a_rotation_names_index_and_reason(case):
     assert "orthonormalize=True" in msg
     _raises(rk.NotARotationError, lambda: rk.Rotation.from_matrix(bad), "single", reason)
     _raises(rk.NotARotationError, lambda: rk.so3.log(m), "(1, 2)")
+
+
+@pytest.mark.needs("torch")
+@pytest.mark.parametrize("case", list(NOT_ROTATIONS))
+def test_not_a_rotation_in_torch(case):
+    R = rk.Rotation.from_rotvec([0.3, -0.2, 0.5]).as_matrix()
+    m = _batch_with_bad(R, NOT_ROTATIONS[case][0])
     _raises(rk.NotARotationError, lambda: C.quat_from_matrix(torch.tensor(m)), "(1, 2)")
 
 
@@ -210,7 +228,15 @@ def test_orthonormalize_gives_the_nearest_rotation(noise, rng):
 
     for k in range(2, 50):
         np.testing.assert_allclose(got[k], polar(m[k])[0], atol=1e-14)
-    # torch in, torch out, same rotation
+
+
+@pytest.mark.needs("torch")
+def test_orthonormalize_torch_in_torch_out(rng):
+    R = rk.Rotation.random(50, rng).as_matrix()
+    m = R + 0.3 * rng.standard_normal(R.shape)
+    m[0] = np.diag([1.0, 1.0, -1.0])
+    m[1] = SHEAR
+    want = _nearest_by_svd(m)
     t = rk.Rotation.from_matrix(torch.tensor(m), orthonormalize=True).as_matrix()
     assert isinstance(t, torch.Tensor)
     np.testing.assert_allclose(t.numpy(), want, atol=1e-14)
