@@ -612,15 +612,13 @@ def test_an_error_naming_no_batch_index_is_located_by_bisection(
 
 
 @pytest.mark.parametrize("suffix", [".npy", ".csv"])
-def test_the_row_named_comes_from_err_index(suffix, tmp_path, capsys, monkeypatch):
+@pytest.mark.parametrize("message", ["MRP is bad", "MRP at batch index (1234,) is bad"])
+def test_the_row_named_comes_from_err_index(suffix, message, tmp_path, capsys, monkeypatch):
     from rigidkit.errors import RigidkitError
 
-    # Every prefix of the batch fails, so bisection would blame the first row, and
-    # the message names another index: only err.index gives row 1235.
-    _picky_from_mrp(
-        monkeypatch,
-        lambda p: RigidkitError("MRP at batch index (1234,) is bad", index=(1234,)),
-    )
+    # Every prefix of the batch fails, so bisection would blame the first row: only
+    # err.index gives row 1235. The library's own "at batch index" gives way to it.
+    _picky_from_mrp(monkeypatch, lambda p: RigidkitError(message, index=(1234,)))
     a = np.zeros((2000, 3))
     path = tmp_path / f"in{suffix}"
     if suffix == ".npy":
@@ -657,6 +655,244 @@ def test_a_gimbal_lock_warning_carrying_its_index_is_placed_by_it(
     assert code == 0 and len(out.splitlines()) == 6
     where = f"{tmp_path / 'in.npy'} row 3 (index 2)"
     assert err == f"rigidkit: warning: {where}: gimbal lock (made up)\n"
+
+
+# -- batch files: nothing lost, nothing guessed ----------------------------------------
+
+
+def convert_file(tmp_path, capsys, text, source, to="quat", extra=(), name="in.csv"):
+    """Run a batch conversion of ``text`` to ``.npy``: (code, table or None, err)."""
+    path = tmp_path / name
+    if isinstance(text, bytes):
+        path.write_bytes(text)
+    else:
+        path.write_text(text)
+    out = tmp_path / "out.npy"
+    argv = ["convert", "--from", source, "-i", path, "-o", out, "--to", to, *extra]
+    code, stdout, err = run(argv, capsys)
+    assert stdout == ""
+    return code, (np.load(out) if code == 0 else None), err
+
+
+ZYX_DEG = np.array([[10.0, 20.0, 30.0], [40.0, -50.0, 60.0], [-170.0, 5.0, 1.5]])
+
+
+def test_a_csv_of_quoted_numbers_is_data_not_a_header(tmp_path, capsys):
+    # One row: never an empty output.
+    one = '"10","20","30"\n'
+    code, table, err = convert_file(tmp_path, capsys, one, "euler:ZYX", extra=["--degrees"])
+    assert (code, err) == (0, "")
+    check_against_scipy(
+        "quat", table, SciRot.from_euler("ZYX", [ZYX_DEG[0]], degrees=True), 0
+    )
+    # Two rows: both converted, none dropped.
+    two = "".join(
+        ",".join(f'"{x}"' for x in number_args(row)) + "\n" for row in ZYX_DEG[:2]
+    )
+    code, table, err = convert_file(tmp_path, capsys, two, "euler:ZYX", extra=["--degrees"])
+    assert (code, err, table.shape) == (0, "", (2, 4))
+    check_against_scipy(
+        "quat", table, SciRot.from_euler("ZYX", ZYX_DEG[:2], degrees=True), 0
+    )
+    # A bad second row is named by its own line.
+    bad = '"10","20","30"\n"1","x","3"\n'
+    code, _, err = convert_file(tmp_path, capsys, bad, "euler:ZYX", extra=["--degrees"])
+    assert code == 2 and "line 2 (data row 2): field 2 is 'x'" in err
+    # A quoted header is still a header.
+    head = '"w","x","y","z"\n"1","0","0","0"\n'
+    code, table, _ = convert_file(tmp_path, capsys, head, "quat", to="rotvec")
+    assert code == 0 and table.tolist() == [[0.0, 0.0, 0.0]]
+
+
+@pytest.mark.parametrize("sep", [";", "\t", " ", "  "])
+@pytest.mark.parametrize("header", [False, True])
+def test_semicolon_tab_and_space_separated_files(sep, header, tmp_path, capsys):
+    lines = ["yaw pitch roll".replace(" ", sep)] if header else []
+    lines += [sep.join(number_args(row)) for row in ZYX_DEG]
+    text = "\n".join(lines) + "\n"
+    code, table, err = convert_file(
+        tmp_path, capsys, text, "euler:ZYX", extra=["--degrees"]
+    )
+    assert (code, err) == (0, "")
+    check_against_scipy("quat", table, SciRot.from_euler("ZYX", ZYX_DEG, degrees=True), 0)
+    # A wrong field count names the delimiter found; a header, what it names.
+    code, _, err = convert_file(tmp_path, capsys, text, "quat")
+    name = {";": "';'", "\t": "tab"}.get(sep, "spaces")
+    want = "the header (yaw, pitch, roll)" if header else f"got 3 (separated by {name})"
+    assert code == 2 and want in err
+
+
+def test_a_decimal_comma_is_explained(tmp_path, capsys):
+    code, _, err = convert_file(tmp_path, capsys, "1,5;2;3\n", "euler:ZYX")
+    assert code == 2 and "field 1 is '1,5', not a number" in err and "decimal" in err
+
+
+Q_WXYZ = wxyz(SciRot.from_euler("ZYX", ZYX_DEG, degrees=True).as_quat())
+
+
+def _columns(header, rows, order):
+    return (
+        "\n".join([header, *(",".join(repr(float(r[k])) for k in order) for r in rows)])
+        + "\n"
+    )
+
+
+@pytest.mark.parametrize(
+    "header, order, source",
+    [
+        # order: which w x y z component is in each column of the file
+        ("qx,qy,qz,qw", [1, 2, 3, 0], "quat"),
+        ("x,y,z,w", [1, 2, 3, 0], "quat"),
+        ("w,x,y,z", [0, 1, 2, 3], "quat:xyzw"),
+        ("q_w,q_x,q_y,q_z", [0, 1, 2, 3], "quat:xyzw"),
+        ("QW, QX, QY, QZ", [0, 1, 2, 3], "quat"),
+        ("quat.w,quat.x,quat.y,quat.z", [0, 1, 2, 3], "quat:xyzw"),
+        ("quat:xyzw.x,quat:xyzw.y,quat:xyzw.z,quat:xyzw.w", [1, 2, 3, 0], "quat"),
+        ("a,b,c,d", [0, 1, 2, 3], "quat"),  # names no component: file order
+    ],
+)
+def test_a_header_naming_quaternion_components_is_honoured(
+    header, order, source, tmp_path, capsys
+):
+    text = _columns(header, Q_WXYZ, order)
+    code, table, err = convert_file(tmp_path, capsys, text, source, to="quat")
+    assert (code, err) == (0, "")
+    check_against_scipy("quat", table, SciRot.from_quat(np.roll(Q_WXYZ, -1, axis=-1)), 0)
+
+
+@pytest.mark.parametrize(
+    "header, seq, order",
+    [
+        # order: which of (roll, pitch, yaw) = angles about (x, y, z) each column holds
+        ("roll,pitch,yaw", "ZYX", [0, 1, 2]),
+        ("yaw,pitch,roll", "ZYX", [2, 1, 0]),
+        ("pitch,roll,yaw", "xyz", [1, 0, 2]),
+        ("Roll,Yaw,Pitch", "YXZ", [0, 2, 1]),
+    ],
+)
+def test_a_roll_pitch_yaw_header_is_honoured(header, seq, order, tmp_path, capsys):
+    rpy = np.array([[5.0, 10.0, 20.0], [-30.0, 40.0, 170.0]])  # about x, y, z
+    text = _columns(header, rpy, order)
+    code, table, err = convert_file(
+        tmp_path, capsys, text, f"euler:{seq}", extra=["--degrees"]
+    )
+    assert (code, err) == (0, "")
+    by_axis = {"x": rpy[:, 0], "y": rpy[:, 1], "z": rpy[:, 2]}
+    angles = np.stack([by_axis[a] for a in seq.lower()], axis=-1)
+    check_against_scipy("quat", table, SciRot.from_euler(seq, angles, degrees=True), 0)
+
+
+def test_a_column_major_matrix_header_is_honoured(tmp_path, capsys):
+    S = random_rotations(5, seed=11)
+    m = S.as_matrix()
+    header = ",".join(f"r{i}{j}" for j in "123" for i in "123")  # column by column
+    text = _columns(header, m.transpose(0, 2, 1).reshape(-1, 9), range(9))
+    code, table, err = convert_file(tmp_path, capsys, text, "matrix")
+    assert (code, err) == (0, "")
+    check_against_scipy("quat", table, S, 0)
+
+
+@pytest.mark.parametrize(
+    "header, source",
+    [
+        ("qx,qy,qz,qw", "rotvec"),
+        ("time,qx,qy,qz", "quat"),
+        ("w,x,y,y", "quat"),
+        ("roll,pitch,yaw", "euler:ZXZ"),  # two turns about z: roll/pitch/yaw are unclear
+        ("x,y,z", "euler:ZYX"),
+        ("rotvec.x,rotvec.y,rotvec.z", "mrp"),
+        ("euler:XYZ.angle1,euler:XYZ.angle2,euler:XYZ.angle3", "euler:ZYX"),
+        ("w,x,y,z", "matrix"),
+    ],
+)
+def test_a_header_contradicting_the_representation_is_rejected(
+    header, source, tmp_path, capsys
+):
+    k = 9 if source == "matrix" else (4 if source.startswith("quat") else 3)
+    row = ",".join(["0.1"] * k)
+    code, table, err = convert_file(tmp_path, capsys, f"{header}\n{row}\n", source)
+    assert code == 2 and err.count("\n") == 1
+    assert "line 1: the header" in err and source in err
+    assert sorted(os.listdir(tmp_path)) == ["in.csv"]
+
+
+def test_euler_angles_that_look_like_degrees_are_warned_about(tmp_path, capsys):
+    code, out, err = run(["convert", "euler:ZYX", "30", "20", "10", "--to", "quat"], capsys)
+    assert code == 0 and err.startswith("rigidkit: warning: ") and err.count("\n") == 1
+    assert "2*pi" in err and "degrees" in err
+    # Still read as radians, as documented.
+    got = parse_table(out)["quat"]
+    check_against_scipy("quat", got, SciRot.from_euler("ZYX", [30, 20, 10]), False)
+    assert run(["convert", "euler:ZYX", "30", "20", "10", "--degrees"], capsys)[2] == ""
+    assert (
+        run(["convert", "euler:ZYX", "6.28", "-6.28", "1", "--to", "quat"], capsys)[2] == ""
+    )
+    # In a batch: the first such row is named.
+    text = "0.1,0.2,0.3\n0.1,-7,0.3\n1,2,3\n9,9,9\n"
+    code, table, err = convert_file(tmp_path, capsys, text, "euler:ZYX")
+    assert code == 0 and table.shape == (4, 4) and err.count("\n") == 1
+    assert "line 2 (data row 2)" in err and "looks like degrees" not in err
+    assert "look like degrees" in err and "1 more" in err
+    assert convert_file(tmp_path, capsys, text, "euler:ZYX", extra=["--degrees"])[2] == ""
+
+
+def test_the_positional_representation_works_with_a_file(tmp_path, capsys):
+    path = tmp_path / "in.csv"
+    path.write_text("\n".join(",".join(number_args(row)) for row in ZYX_DEG) + "\n")
+    outs = []
+    for spelling in (["euler:ZYX"], ["--from", "euler:ZYX"]):
+        out = tmp_path / f"out{len(outs)}.csv"
+        argv = ["convert", *spelling, "--input", path, "--output", out, "--to", "quat"]
+        code, _, err = run(argv + ["--degrees"], capsys)
+        assert (code, err) == (0, "")
+        outs.append(out.read_text())
+    assert outs[0] == outs[1]
+    table = np.loadtxt(io.StringIO(outs[0]), delimiter=",", skiprows=1)
+    check_against_scipy("quat", table, SciRot.from_euler("ZYX", ZYX_DEG, degrees=True), 0)
+    # Given twice it must agree, and no numbers may follow it.
+    argv = ["convert", "quat", "--from", "euler:ZYX", "-i", path, "--to", "quat"]
+    code, _, err = run(argv, capsys)
+    assert code == 2 and "give no rotation" in err
+    code, _, err = run(["convert", "euler:ZYX", "1", "-i", path, "--to", "quat"], capsys)
+    assert code == 2 and "give no rotation" in err
+
+
+@pytest.mark.parametrize("kind", ["object", "structured", "pickle", "text"])
+def test_a_npy_that_is_not_a_numeric_array_says_so(kind, tmp_path, capsys):
+    path = tmp_path / "in.npy"
+    if kind == "object":
+        np.save(path, np.array([{"w": 1}, None], dtype=object), allow_pickle=True)
+    elif kind == "structured":
+        np.save(path, np.zeros(3, dtype=[("w", "f8"), ("x", "f8")]))
+    elif kind == "pickle":
+        import pickle
+
+        path.write_bytes(pickle.dumps([[1.0, 0.0, 0.0, 0.0]]))
+    else:
+        path.write_text("1,0,0,0\n")
+    argv = ["convert", "--from", "quat", "-i", path, "--to", "quat"]
+    code, out, err = run(argv, capsys)
+    assert code == 2 and out == "" and err.count("\n") == 1
+    assert "allow_pickle" not in err
+    if kind in ("object", "structured"):
+        assert "not a numeric array" in err
+    else:
+        assert "not a .npy file" in err
+
+
+def test_fewer_rows_parsed_than_data_lines_is_an_error(tmp_path, capsys, monkeypatch):
+    real = np.loadtxt
+    monkeypatch.setattr(np, "loadtxt", lambda *a, **k: real(*a, **k)[:-1])
+    text = "w,x,y,z\n1,0,0,0\n0,1,0,0\n"
+    code, _, err = convert_file(tmp_path, capsys, text, "quat")
+    assert code == 2 and "read 1 rows from 2 data lines" in err
+    assert sorted(os.listdir(tmp_path)) == ["in.csv"]
+
+
+def test_a_byte_order_mark_does_not_hide_the_header(tmp_path, capsys):
+    text = "\ufeffqx,qy,qz,qw\n0,0,0,1\n".encode()
+    code, table, err = convert_file(tmp_path, capsys, text, "quat", to="rotvec")
+    assert (code, err, table.tolist()) == (0, "", [[0.0, 0.0, 0.0]])
 
 
 # -- the two ways to run it from a shell -----------------------------------------------
