@@ -7,6 +7,8 @@ Euler UPPER = intrinsic, lower = extrinsic; twists ``(v, omega)``; radians unles
 """
 
 from .errors import (
+    ConvergenceWarning,
+    DegenerateInputError,
     EulerSequenceError,
     GimbalLockWarning,
     NonFiniteError,
@@ -131,7 +133,9 @@ __all__ = [
     "ZeroNormError",
     "ShapeError",
     "EulerSequenceError",
+    "DegenerateInputError",
     "GimbalLockWarning",
+    "ConvergenceWarning",
 ]
 
 

@@ -18,7 +18,9 @@ __all__ = [
     "NotAffineError",
     "SingularMatrixError",
     "PointAtInfinityError",
+    "DegenerateInputError",
     "GimbalLockWarning",
+    "ConvergenceWarning",
 ]
 
 
@@ -92,6 +94,11 @@ class PointAtInfinityError(RigidkitError):
     """A projective transform maps a point to infinity (homogeneous ``w = 0``)."""
 
 
+class DegenerateInputError(RigidkitError):
+    """The data do not determine the result: weights that sum to zero or are
+    negative, too few (or collinear) points to fix a rotation, all-zero vectors."""
+
+
 class GimbalLockWarning(UserWarning):
     """Euler angles were requested at (or numerically at) gimbal lock.
 
@@ -99,3 +106,8 @@ class GimbalLockWarning(UserWarning):
     and third angle is then a convention (the third angle is set to zero at
     exact lock).
     """
+
+
+class ConvergenceWarning(UserWarning):
+    """An iteration (the Karcher mean, a spline solve) stopped at its step limit
+    before reaching its tolerance; the last iterate is returned."""
