@@ -35,8 +35,8 @@ def format_table(rows, decimals=None) -> str:
     """Align ``(name, label, numbers)`` rows; numbers align on their decimal point.
 
     >>> print(format_table([("a", "x y", [1.5, -10.0]), ("bb", "z", [0.25])]))
-    a   x y   1.5  -10.0
-    bb  z     0.25
+    a   x y  1.5   -10.0
+    bb  z    0.25
     """
     cells = [
         (name, label, [_split_at_point(_format_number(x, decimals)) for x in nums])
