@@ -75,6 +75,7 @@ def _npy_dtype(path: str):
 
 
 def read_npy(path: str, source):
+    """``(values, where)`` of ``path``: shape (N, k), or (N, 3, 3) for matrices."""
     try:
         dtype = _npy_dtype(path)
         if dtype is not None and dtype.kind not in "fiu":
@@ -138,6 +139,7 @@ def _choose_delimiter(sample, size: int):
 
 
 def read_csv(path: str, source):
+    """``(values, where)`` of the CSV file ``path`` (``-``: stdin); see the module."""
     name = "<stdin>" if path == "-" else path
     try:
         if path == "-":
