@@ -3,8 +3,9 @@
 References: scipy.linalg.expm / logm of the 4x4 hat matrix, mpmath at 50+
 digits (``mp.expm``, the series ``J_l = sum_k ad^k / (k+1)!`` and the coefficient
 definitions), scipy's ``RigidTransform`` (whose exponential coordinates are
-ordered ``(w, v)``, ours ``(v, w)``), central finite differences, the closed forms
-of the notes and of DESIGN.md's errata written out here with NumPy.
+ordered ``(w, v)``, ours ``(v, w)``), the closed forms of the notes and of
+DESIGN.md's errata written out here with NumPy. (Central finite differences check
+every group's Jacobians at once, in ``test_jacobians_fd.py``.)
 """
 
 from __future__ import annotations
@@ -280,37 +281,7 @@ def _tf_log(T):
     return np.concatenate([e[..., 3:], e[..., :3]], -1)
 
 
-DIRECTIONS = np.vstack([np.eye(6), np.random.default_rng(11).standard_normal((5, 6))])
-DIRECTIONS /= np.linalg.norm(DIRECTIONS, axis=-1, keepdims=True)
-# Central differences, h = 1e-5: truncation h^2/6 |f'''| and rounding eps/h are
-# both ~1e-11 for |w| <= 3 and |v| ~ 1; 1e-8 allows for |v| up to a few and for
-# the rounding of scipy's own exp/log, and is 1e3 below a one-coefficient mistake.
-H = 1e-5
-FD_TOL = 1e-8
-
-
-@pytest.mark.parametrize("theta", [0.0, 1e-8, 1e-4, 0.05, 1.0, 2.0, 3.0])
-def test_jacobians_by_finite_differences(theta, rng):
-    """All four Jacobians, along 11 non-parallel directions, against scipy's exp/log."""
-    xi = twist(rng, theta)
-    T0 = _tf_exp(xi)
-    cases = {
-        "left": (rk.se3.left_jacobian(xi), lambda d: _tf_log(_tf_exp(xi + d) * T0.inv())),
-        "right": (rk.se3.right_jacobian(xi), lambda d: _tf_log(T0.inv() * _tf_exp(xi + d))),
-        "left_inverse": (
-            rk.se3.left_jacobian_inverse(xi),
-            lambda d: _tf_log(_tf_exp(d) * T0),
-        ),
-        "right_inverse": (
-            rk.se3.right_jacobian_inverse(xi),
-            lambda d: _tf_log(T0 * _tf_exp(d)),
-        ),
-    }
-    for name, (J, f) in cases.items():
-        for d in DIRECTIONS:
-            fd = (f(H * d) - f(-H * d)) / (2 * H)
-            err = np.abs(J @ d - fd).max()
-            assert err <= FD_TOL, (name, d, err)
+# Finite differences of every group's Jacobians: tests/test_jacobians_fd.py.
 
 
 def test_jacobian_inverse_and_v_matrix(rng):
@@ -648,13 +619,6 @@ def test_backends_agree(name, make, rng):
     single = [x[7] for x in args]
     c = k(*single, backend="python")
     np.testing.assert_allclose(c, a[7], rtol=0, atol=4 * EPS * (1 + np.abs(a).max()))
-
-
-@pytest.mark.slow
-def test_jacobian_kernels_numba_backend(rng):
-    xi = twist(rng, 1.0, 32)
-    for k in (k_se3.left_jacobian, k_se3.left_jacobian_inverse):
-        np.testing.assert_allclose(k(xi, backend="numba"), k(xi, backend="xp"), atol=1e-14)
 
 
 def test_sympy_twin_of_exp():

@@ -1,9 +1,9 @@
 """SO(3) calculus: Jacobians, their inverses, the bracket, and the notes' identities.
 
 References: mpmath at 50 digits (the coefficient definitions and the series
-``J_l = sum_k hat(w)^k / (k+1)!``), central finite differences of scipy's
-``Rotation`` exp/log, torch autograd through rigidkit's own torch path, and the
-identities of the notes written out with NumPy.
+``J_l = sum_k hat(w)^k / (k+1)!``), torch autograd through rigidkit's own torch path,
+and the identities of the notes written out with NumPy. (Central finite differences
+check every group's Jacobians at once, in ``test_jacobians_fd.py``.)
 
 Convention under test: ``exp(w + d) ~ exp(J_l d) exp(w) ~ exp(w) exp(J_r d)``.
 """
@@ -165,67 +165,14 @@ def test_structure_of_the_jacobians(rng):
     np.testing.assert_allclose(np.einsum("nij,nj->ni", Jl, w), w, rtol=0, atol=8 * EPS)
 
 
-# -- Jacobians against finite differences of scipy's exp/log ---------------------------
+# -- Jacobians by autodiff (finite differences: tests/test_jacobians_fd.py) -----------
 
 
-def _exp(w):
-    return SciRot.from_rotvec(w)
-
-
-def _log(R):
-    return R.as_rotvec()
-
-
-DIRECTIONS = np.vstack([np.eye(3), np.random.default_rng(7).standard_normal((4, 3))])
-DIRECTIONS /= np.linalg.norm(DIRECTIONS, axis=-1, keepdims=True)
-FD_ANGLES = [0.0, 1e-8, 1e-4, 0.03, 0.5, 1.5, 2.5, 3.0]
-# Central differences with step h: truncation h^2/6 |f'''| and rounding ~eps/h.
-# With h = 1e-5 both are ~1e-11 for these smooth maps (|f'''| = O(1) below
-# 3 rad); 1e-9 leaves room for the growth of f''' towards pi and is still
-# 1e5 times smaller than the change a wrong coefficient (or side) would make.
-H = 1e-5
-FD_TOL = 1e-9
-
-
-@pytest.mark.parametrize("theta", FD_ANGLES)
-def test_jacobians_by_finite_differences(theta, rng):
-    w = theta * unit(rng)
-    R0 = _exp(w)
-    cases = {
-        # name: (our matrix, function of the perturbation whose derivative it is)
-        "left": (rk.so3.left_jacobian(w), lambda d: _log(_exp(w + d) * R0.inv())),
-        "right": (rk.so3.right_jacobian(w), lambda d: _log(R0.inv() * _exp(w + d))),
-        "left_inverse": (
-            rk.so3.left_jacobian_inverse(w),
-            lambda d: _log(_exp(d) * R0),
-        ),
-        "right_inverse": (
-            rk.so3.right_jacobian_inverse(w),
-            lambda d: _log(R0 * _exp(d)),
-        ),
-    }
-    for name, (J, f) in cases.items():
-        for d in DIRECTIONS:
-            fd = (f(H * d) - f(-H * d)) / (2 * H)
-            err = np.abs(J @ d - fd).max()
-            assert err <= FD_TOL, (name, d, err)
-
-
-def test_sides_are_distinguished_by_finite_differences(rng):
-    """The test above has power: the left Jacobian fails as a right Jacobian."""
-    w = 1.0 * unit(rng)
-    R0 = _exp(w)
-    d = DIRECTIONS[3]
-    fd = (_log(R0.inv() * _exp(w + H * d)) - _log(R0.inv() * _exp(w - H * d))) / (2 * H)
-    assert np.abs(rk.so3.left_jacobian(w) @ d - fd).max() > 1e3 * FD_TOL
-
-
-def test_right_jacobian_by_torch_autograd(rng):
+def test_right_jacobian_by_torch_autograd(torch, rng):
     """Autodiff through rigidkit's torch path: ``2 q(w)* dq/dw = (0, J_r(w))``.
 
     Differentiating ``q(w + d) = q(w) exp((J_r d) / 2)`` at ``d = 0``.
     """
-    torch = pytest.importorskip("torch")
     for theta in (1e-6, 0.7, 2.9):
         w = theta * unit(rng)
 
@@ -251,7 +198,7 @@ vec = st.lists(st.floats(-10, 10, allow_nan=False), min_size=3, max_size=3).map(
 @settings(max_examples=100, deadline=None)
 @given(vec, vec, vec)
 def test_jacobi_identity_and_double_cross_product(a, b, c):
-    """``[a,[b,c]] + [b,[c,a]] + [c,[a,b]] = 0`` and ``a x (b x c) = b (a.c) - c (a.b)``."""
+    """Jacobi, ``a x (b x c) = b (a.c) - c (a.b)``, ``[hat a, hat b] = hat(a x b)``."""
     br = rk.so3.bracket
     jacobi = br(a, br(b, c)) + br(b, br(c, a)) + br(c, br(a, b))
     size = (1 + np.abs(a).max()) * (1 + np.abs(b).max()) * (1 + np.abs(c).max())
@@ -259,12 +206,14 @@ def test_jacobi_identity_and_double_cross_product(a, b, c):
     np.testing.assert_allclose(
         br(a, br(b, c)), b * (a @ c) - c * (a @ b), rtol=0, atol=16 * EPS * size
     )
-    # [hat(a), hat(b)] = hat(a x b), and ad = hat.
     A, B = rk.so3.hat(a), rk.so3.hat(b)
     np.testing.assert_allclose(
         A @ B - B @ A, rk.so3.hat(np.cross(a, b)), rtol=0, atol=16 * EPS * size
     )
-    np.testing.assert_array_equal(rk.so3.ad(a), A)
+    # ad(a) b = [a, b] = a x b, against NumPy's cross product.
+    np.testing.assert_allclose(
+        rk.so3.ad(a) @ b, np.cross(a, b), rtol=0, atol=4 * EPS * size
+    )
 
 
 def test_conjugated_hat_and_hat_squared(rng):
@@ -310,10 +259,16 @@ def test_batches_dtypes_and_namespaces(rng):
         f32 = fn(w.astype(np.float32))
         assert f32.dtype == np.float32
         np.testing.assert_allclose(f32, fn(w), rtol=0, atol=2e-6 * np.abs(fn(w)).max())
-    torch = pytest.importorskip("torch")
+    assert rk.so3.bracket(w, w[0, 0]).shape == (2, 5, 3)
+
+
+def test_torch_in_torch_out(torch, rng):
+    w = rng.standard_normal((2, 5, 3))
     t = rk.so3.left_jacobian(torch.tensor(w, dtype=torch.float32))
     assert isinstance(t, torch.Tensor) and t.dtype == torch.float32
-    assert rk.so3.bracket(w, w[0, 0]).shape == (2, 5, 3)
+    np.testing.assert_allclose(
+        t.numpy(), rk.so3.left_jacobian(w), rtol=0, atol=2e-6 * np.abs(t.numpy()).max()
+    )
 
 
 def test_bad_input_raises():
