@@ -1,0 +1,109 @@
+"""Rotations and rigid motions from data: ``rk.align_vectors`` and ``rk.align_points``.
+
+``align_vectors(a, b)`` returns the rotation ``A_R_B`` with ``a_i ~ A_R_B @ b_i``
+(scipy's order) that minimises the weighted squared residuals (Wahba's problem,
+Kabsch's SVD with the reflection fix); ``align_points(src, dst)`` the transform
+``dst_T_src`` with ``dst_i ~ dst_T_src @ src_i`` (Kabsch on centred points), or a
+similarity with ``scale=True`` (Umeyama). Both are batched: inputs ``(..., N, 3)``
+give ``...`` problems at once. The algorithms are in
+:mod:`rigidkit.functional.alignment`.
+"""
+
+from __future__ import annotations
+
+from ..functional import alignment as _fa
+from ..objects.rotation import Rotation
+from ..objects.transform import Transform
+
+__all__ = ["align_vectors", "align_points"]
+
+
+def align_vectors(a, b, weights=None):
+    """The rotation ``R`` minimising ``sum_i w_i |a_i - R b_i|^2``, and its residual.
+
+    Exact (to rounding) for noiseless data, for a single pair (the shortest arc
+    from ``b`` to ``a``) and when all vectors are parallel or antiparallel (the
+    rotation about their line is then undetermined; the shortest arc is returned).
+
+    Parameters
+    ----------
+    a : array_like, shape (..., N, 3)
+        Vectors in frame A.
+    b : array_like, shape (..., N, 3)
+        The same vectors in frame B; batch shapes broadcast.
+    weights : array_like, shape (..., N), optional
+        Non-negative weights (equal if omitted).
+
+    Returns
+    -------
+    rotation : Rotation, shape (...)
+        ``A_R_B``.
+    rssd : array, shape (...)
+        ``sqrt(sum_i w_i |a_i - R b_i|^2)``, computed from the residuals (noiseless
+        data gives ~1e-15, not the ~1e-7 of scipy's cancelling formula).
+
+    Raises
+    ------
+    DegenerateInputError
+        Negative weights, or all pairs zero or of zero weight.
+    NonFiniteError
+        NaN or infinity in the input.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import rigidkit as rk
+    >>> A_R_B = rk.Rotation.from_rotvec([0.1, 0.2, 0.3])
+    >>> b = np.random.default_rng(0).standard_normal((20, 3))
+    >>> R, rssd = rk.align_vectors(A_R_B @ b, b)
+    >>> bool(R.approx_equal(A_R_B, atol=1e-14)), bool(rssd < 1e-13)
+    (True, True)
+    """
+    quat, rssd = _fa.kabsch(a, b, weights)
+    return Rotation._wrap(quat), rssd
+
+
+def align_points(src, dst, weights=None, *, scale=False):
+    """The rigid motion (or similarity) taking points ``src`` onto ``dst``.
+
+    Minimises ``sum_i w_i |dst_i - T @ src_i|^2`` over rigid motions ``T``
+    (``scale=False``: Kabsch on the weighted centroids) or similarities
+    ``p -> s R p + t`` (``scale=True``: Umeyama 1991).
+
+    Parameters
+    ----------
+    src, dst : array_like, shape (..., N, 3)
+        Corresponding points, ``N >= 3`` of them not collinear; batch shapes
+        broadcast.
+    weights : array_like, shape (..., N), optional
+        Non-negative weights (equal if omitted).
+    scale : bool
+        Also fit a uniform scale.
+
+    Returns
+    -------
+    Transform or Similarity, shape (...)
+        ``dst_T_src``.
+
+    Raises
+    ------
+    DegenerateInputError
+        Fewer than 3 points; weights negative or summing to zero; points (of
+        positive weight) coincident or collinear, naming the batch index.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import rigidkit as rk
+    >>> dst_T_src = rk.Transform.exp([0.5, -1.0, 2.0, 0.1, 0.2, 0.3])
+    >>> src = np.random.default_rng(0).standard_normal((10, 3))
+    >>> T = rk.align_points(src, dst_T_src @ src)
+    >>> bool(T.approx_equal(dst_T_src, atol=1e-13))
+    True
+    """
+    pose = _fa.umeyama(src, dst, weights, scale=scale)
+    if scale:
+        from ..objects.similarity import Similarity
+
+        return Similarity._wrap(pose)
+    return Transform._wrap(pose)

@@ -1,0 +1,183 @@
+"""Geodesic interpolation of rotations and rigid motions: ``rk.slerp`` and ``rk.Slerp``.
+
+The geodesic from ``X0`` (``t = 0``) to ``X1`` (``t = 1``) is ``X0 (X0^-1 X1)^t``,
+``X^t = exp(t log X)``, the log's angle in [0, pi] (shortest path, whatever the
+quaternion signs). For a :class:`~rigidkit.Transform` it is the screw motion with
+constant body twist; ``decoupled=True`` interpolates the rotation by slerp and
+the translation on a straight line. Conventions: Hamilton quaternions, scalar
+first; ``A_R_C = A_R_B @ B_R_C`` applies ``B_R_C`` first.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._validate import finite_array, to_numpy
+from ..errors import DegenerateInputError, OutOfRangeError, ShapeError
+from ..functional import interpolation as _fi
+from ..objects.rotation import Rotation
+from ..objects.transform import Transform
+
+__all__ = ["slerp", "Slerp"]
+
+
+def slerp(a, b, t, *, decoupled=False):
+    """The point at fraction ``t`` of the geodesic from ``a`` to ``b``.
+
+    Parameters
+    ----------
+    a, b : Rotation or Transform
+        The ends, of one kind; batch shapes broadcast.
+    t : array_like, shape (...)
+        Fractions, broadcasting with the batch: 0 gives ``a`` exactly, 1 gives
+        ``b``; outside [0, 1] the geodesic is extended.
+    decoupled : bool
+        Transforms only: slerp the rotation and interpolate the translation
+        linearly, ``(1 - t) t_a + t t_b``, instead of the screw motion.
+
+    Returns
+    -------
+    Rotation or Transform
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import rigidkit as rk
+    >>> A_R_B = rk.Rotation.identity()
+    >>> A_R_C = rk.Rotation.from_rotvec([0.0, 0.0, np.pi / 2])
+    >>> np.round(rk.slerp(A_R_B, A_R_C, [0.0, 0.5, 1.0]).as_rotvec()[:, 2], 12)
+    array([0.        , 0.78539816, 1.57079633])
+    """
+    if isinstance(a, Transform) and isinstance(b, Transform):
+        return Transform._wrap(
+            _fi.pose_slerp_unchecked(a._pose, b._pose, t, decoupled=decoupled)
+        )
+    if isinstance(a, Rotation) and isinstance(b, Rotation):
+        if decoupled:
+            raise TypeError("decoupled= applies to Transform, not Rotation")
+        return Rotation._wrap(_fi.quat_slerp_unchecked(a._quat, b._quat, t))
+    raise TypeError(
+        "slerp interpolates two Rotations or two Transforms, got "
+        f"{type(a).__name__} and {type(b).__name__}"
+    )
+
+
+def keyframe_times(times, count, what="keyframes"):
+    """``times`` as a strictly increasing float64 NumPy vector of length ``count``."""
+    t = np.asarray(to_numpy(finite_array(times, (), "times")), dtype=np.float64)
+    if t.ndim != 1:
+        raise ShapeError(f"times: expected a 1-D array, got shape {t.shape}")
+    if t.shape[0] != count:
+        raise ShapeError(f"times: {t.shape[0]} times for {count} {what}")
+    bad = np.flatnonzero(np.diff(t) <= 0.0)
+    if bad.size:
+        k = int(bad[0]) + 1
+        raise DegenerateInputError(
+            f"times must be strictly increasing: times[{k}] = {t[k]!r} <= "
+            f"times[{k - 1}] = {t[k - 1]!r}",
+            index=(k,),
+        )
+    return t
+
+
+def query_times(times, lo, hi):
+    """Query ``times`` as a float64 NumPy array (any shape), checked within [lo, hi]."""
+    q = np.asarray(to_numpy(finite_array(times, (), "times")), dtype=np.float64)
+    out = (q < lo) | (q > hi)
+    if out.any():
+        idx = tuple(int(i) for i in np.argwhere(out)[0])
+        raise OutOfRangeError(
+            f"time {q[idx]!r} {'at index ' + str(idx) + ' ' if idx else ''}is outside "
+            f"the interpolation range [{lo!r}, {hi!r}]",
+            index=idx,
+        )
+    return q
+
+
+def keyframe_kind(keyframes, least, what):
+    """The class of ``keyframes`` (Rotation or Transform, time axis first), checked."""
+    if not isinstance(keyframes, (Rotation, Transform)):
+        raise TypeError(
+            f"{what} must be a Rotation or a Transform, got {type(keyframes).__name__}"
+        )
+    if keyframes.single or len(keyframes) < least:
+        n = 1 if keyframes.single else len(keyframes)
+        raise DegenerateInputError(f"{what}: {n} given, at least {least} needed")
+    return type(keyframes)
+
+
+class Slerp:
+    """Piecewise-geodesic interpolation of a keyframe sequence (scipy's ``Slerp``).
+
+    Between ``times[i]`` and ``times[i + 1]`` the result is
+    ``slerp(X_i, X_{i+1}, (t - t_i) / (t_{i+1} - t_i))``: continuous, with
+    constant angular velocity on each interval.
+
+    Parameters
+    ----------
+    times : array_like, shape (n,)
+        Strictly increasing, ``n >= 2``.
+    keyframes : Rotation or Transform, shape (n, ...)
+        The keyframes, time axis first (any further batch axes are interpolated
+        alike). For transforms, the screw motion unless ``decoupled=True``.
+    decoupled : bool
+        Transforms only, see :func:`slerp`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import rigidkit as rk
+    >>> keys = rk.Rotation.from_rotvec([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, 3.0]])
+    >>> interp = rk.Slerp([0.0, 1.0, 2.0], keys)
+    >>> np.round(interp([0.5, 1.5]).as_rotvec()[:, 2], 12)
+    array([0.5, 2. ])
+    """
+
+    def __init__(self, times, keyframes, *, decoupled=False):
+        kind = keyframe_kind(keyframes, 2, "keyframes")
+        if decoupled and kind is Rotation:
+            raise TypeError("decoupled= applies to Transform keyframes, not Rotation")
+        self.times = keyframe_times(times, len(keyframes))
+        self.keyframes = keyframes
+        self.decoupled = decoupled
+        self._dt = np.diff(self.times)
+
+    def __call__(self, times):
+        """The interpolated keyframes at ``times`` (shape (...) -> batch (..., extra)).
+
+        Raises :class:`~rigidkit.OutOfRangeError` outside ``[times[0], times[-1]]``.
+        """
+        q = query_times(times, self.times[0], self.times[-1])
+        flat = q.reshape(-1)
+        idx = _fi.segment_index(self.times, flat)
+        alpha = (flat - self.times[idx]) / self._dt[idx]
+        data = self.keyframes._data
+        extra = data.ndim - 1 - len(self.keyframes._trail)
+        alpha = alpha.reshape(alpha.shape + (1,) * extra)
+        x0 = _take(data, idx)
+        x1 = _take(data, idx + 1)
+        alpha = _like(alpha, data)
+        if isinstance(self.keyframes, Transform):
+            out = _fi.pose_slerp_unchecked(x0, x1, alpha, decoupled=self.decoupled)
+        else:
+            out = _fi.quat_slerp_unchecked(x0, x1, alpha)
+        kind = type(self.keyframes)
+        return kind._wrap(out.reshape(q.shape + tuple(out.shape[1:])))
+
+
+def _take(data, idx):
+    """``data[idx]`` along the time axis, for any array namespace."""
+    if isinstance(data, np.ndarray):
+        return data[idx]
+    from .._engine.namespace import device_of, namespace_of
+
+    return data[namespace_of(data).asarray(idx, device=device_of(data))]
+
+
+def _like(values, data):
+    """NumPy ``values`` in the namespace, dtype and device of ``data``."""
+    if isinstance(data, np.ndarray):
+        return values.astype(data.dtype, copy=False)
+    from .._engine.namespace import device_of, namespace_of
+
+    return namespace_of(data).asarray(values, dtype=data.dtype, device=device_of(data))

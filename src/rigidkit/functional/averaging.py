@@ -1,0 +1,264 @@
+"""Means of rotations and rigid motions, arrays in and out, reduced along batch axes.
+
+Quaternions are Hamilton, scalar first ``(w, x, y, z)``; poses are
+``(w, x, y, z, tx, ty, tz)``; twists ``(v, w)``. Every mean is independent of the
+signs of the input quaternions (``q`` and ``-q`` are one rotation).
+
+==============  ===========================================================
+``chordal``     the rotation nearest the weighted mean of the rotation
+                matrices (Frobenius): the eigenvector of the largest
+                eigenvalue of ``M = sum w_i q_i q_i^T`` (Markley et al. 2007,
+                scipy's ``Rotation.mean``); poses add the weighted mean
+                translation (the Frobenius mean of the 4x4 matrices).
+``geodesic``    the Karcher (Frechet) mean: ``mu <- mu exp(sum w_i log(mu^-1
+                X_i) / sum w_i)`` from the chordal mean until the mean log is
+                below ``tol``; for poses the SE(3) exponential barycenter (the
+                same fixed point with SE(3) logs, Pennec and Arsigny 2012).
+==============  ===========================================================
+
+Written against the array API (namespace of the input; ``linalg.eigh`` of the
+namespace); the Karcher loop tests convergence on concrete values (NumPy-side),
+so it does not trace under ``jax.jit``.
+
+>>> import numpy as np
+>>> q = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0]])   # identity, half turn
+>>> mean = quat_mean(np.array([[0.9, 0.0, 0.0, 0.1], [-0.9, 0.0, 0.0, 0.1]]))
+>>> np.round(mean / mean[0], 12) + 0.0                          # about z, 0 deg
+array([1., 0., 0., 0.])
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+
+from .._engine.namespace import device_of, is_float32, namespace_of
+from .._validate import any_true, batch_index, finite_array, where_text
+from ..errors import ConvergenceWarning, DegenerateInputError
+from ..kernels import quaternion as _kq
+from ..kernels import rotvec as _krv
+from ..kernels import se3 as _kse3
+from . import conversions as _conv
+
+__all__ = [
+    "quat_mean",
+    "quat_mean_unchecked",
+    "pose_mean",
+    "pose_mean_unchecked",
+    "reduce_axes",
+]
+
+#: Default Karcher tolerance on the norm of the mean log (radians; length units).
+GEODESIC_TOL = 1e-12
+GEODESIC_TOL_32 = 1e-6  # float32 cannot represent a mean log below ~1e-7
+
+
+def reduce_axes(axis, nbatch):
+    """Batch axes to reduce, as a sorted tuple of non-negative ints (``None``: all)."""
+    if axis is None:
+        return tuple(range(nbatch))
+    axes = (axis,) if isinstance(axis, int) else tuple(axis)
+    out = []
+    for a in axes:
+        if not -nbatch <= a < nbatch:
+            raise np.exceptions.AxisError(
+                f"axis {a} is out of bounds for a batch of {nbatch} dimensions"
+            )
+        out.append(a % nbatch)
+    return tuple(sorted(set(out)))
+
+
+def _permute(xp, x, order):
+    if hasattr(xp, "permute_dims"):
+        return xp.permute_dims(x, order)
+    return x.permute(*order)  # torch
+
+
+def _grouped(xp, x, axes, trail):
+    """``x`` (batch + trail) as (kept batch, K, trail): reduced axes merged into K."""
+    nb = x.ndim - trail
+    keep = [a for a in range(nb) if a not in axes]
+    order = tuple(keep) + tuple(axes) + tuple(range(nb, x.ndim))
+    y = _permute(xp, x, order)
+    kept = tuple(x.shape[a] for a in keep)
+    k = math.prod(x.shape[a] for a in axes)
+    return xp.reshape(y, kept + (k,) + tuple(x.shape[nb:])), kept
+
+
+def _weights(xp, weights, batch, axes, like):
+    """Weights broadcast to the batch, grouped (kept, K); validated; and their sums."""
+    if weights is None:
+        return None, None
+    w = finite_array(weights, (), "weights")
+    w = xp.asarray(w, dtype=like.dtype, device=device_of(like))
+    w = xp.broadcast_to(w, batch)
+    neg = w < 0.0
+    if any_true(neg):
+        idx = batch_index(neg)
+        raise DegenerateInputError(f"weights are negative {where_text(idx)}", index=idx)
+    g, _ = _grouped(xp, w, axes, 0)
+    total = xp.sum(g, axis=-1)
+    zero = total <= 0.0
+    if any_true(zero):
+        idx = batch_index(zero)
+        raise DegenerateInputError(
+            f"weights sum to zero over the reduced axes {where_text(idx)} of the result; "
+            "the mean is undefined",
+            index=idx,
+        )
+    return g, total
+
+
+def _chordal(xp, q, w):
+    """Dominant eigenvector of ``sum_k w_k q_k q_k^T``; q (kept, K, 4), w (kept, K)."""
+    qw = q if w is None else q * w[..., None]
+    m = q.mT @ qw  # (kept, 4, 4), one BLAS product for NumPy
+    _, vecs = xp.linalg.eigh(m)
+    return vecs[..., :, -1]
+
+
+def _check_count(q, what):
+    if q.shape[-2] == 0:
+        raise DegenerateInputError(f"the mean of zero {what} is undefined")
+
+
+def quat_mean(quats, weights=None, *, method="chordal", axis=None, tol=None, max_iter=100):
+    """Mean rotation of unit quaternions, along batch axes.
+
+    Parameters
+    ----------
+    quats : array_like, shape (..., 4)
+        Unit quaternions (normalised here), scalar first; signs are irrelevant.
+    weights : array_like, shape (...), optional
+        Non-negative weights, broadcasting with the batch shape; equal if omitted.
+    method : {"chordal", "geodesic"}
+        See the module table.
+    axis : int or tuple of int, optional
+        Batch axes to reduce (default: all); the others are kept.
+    tol : float, optional
+        Karcher tolerance on ``|mean log|`` (radians): 1e-12 (float64) or 1e-6
+        (float32) by default.
+    max_iter : int
+        Karcher steps at most; a :class:`~rigidkit.ConvergenceWarning` if reached.
+
+    Returns
+    -------
+    mean : array, shape (kept batch..., 4)
+        Unit quaternion with ``w >= 0``.
+    iterations : int
+        Karcher steps taken (0 for ``"chordal"``).
+
+    Raises
+    ------
+    DegenerateInputError
+        Negative weights, weights that sum to zero, or nothing to average.
+    """
+    q = _conv.quat_normalize(quats, what="quaternions")
+    return quat_mean_unchecked(
+        q, weights, method=method, axis=axis, tol=tol, max_iter=max_iter
+    )
+
+
+def quat_mean_unchecked(
+    q, weights=None, *, method="chordal", axis=None, tol=None, max_iter=100
+):
+    """:func:`quat_mean` of quaternions known to be unit and finite (not checked).
+
+    The weights are still validated. :meth:`rigidkit.Rotation.mean` calls this.
+    """
+    xp = namespace_of(q)
+    axes = reduce_axes(axis, q.ndim - 1)
+    batch = tuple(q.shape[:-1])
+    g, kept = _grouped(xp, q, axes, 1)
+    _check_count(g, "rotations")
+    w, total = _weights(xp, weights, batch, axes, q)
+    mean = _chordal(xp, g, w)
+    iterations = 0
+    if method == "geodesic":
+        tol = _tol(tol, q.dtype)
+        for iterations in range(1, max_iter + 1):  # noqa: B007
+            rel = _kq.quat_multiply(_kq.quat_conjugate(mean[..., None, :]), g)
+            step = _average(xp, _krv.rotvec_from_quat(rel), w, total)
+            mean = _kq.quat_multiply(mean, _krv.quat_from_rotvec(step))
+            if _converged(xp, step, tol):
+                break
+        else:
+            _warn_unconverged(max_iter, tol)
+    elif method != "chordal":
+        raise ValueError(f"method must be 'chordal' or 'geodesic', got {method!r}")
+    return _kq.quat_canonical(mean), iterations
+
+
+def pose_mean(poses, weights=None, *, method="chordal", axis=None, tol=None, max_iter=100):
+    """Mean rigid motion of poses ``(w, x, y, z, tx, ty, tz)``, along batch axes.
+
+    Parameters and returns as :func:`quat_mean`, with poses (..., 7) in and out;
+    ``"chordal"`` is the chordal rotation mean with the weighted mean translation,
+    ``"geodesic"`` the SE(3) exponential barycenter (see the module table), whose
+    tolerance bounds the norm of the mean twist (radians and length units alike).
+    """
+    p = finite_array(poses, (7,), "poses")
+    xp = namespace_of(p)
+    q = _conv.quat_normalize(p[..., :4], what="pose quaternions")
+    p = xp.concat([q, p[..., 4:]], axis=-1)
+    return pose_mean_unchecked(
+        p, weights, method=method, axis=axis, tol=tol, max_iter=max_iter
+    )
+
+
+def pose_mean_unchecked(
+    p, weights=None, *, method="chordal", axis=None, tol=None, max_iter=100
+):
+    """:func:`pose_mean` of poses with unit quaternions, finite (not checked)."""
+    xp = namespace_of(p)
+    axes = reduce_axes(axis, p.ndim - 1)
+    batch = tuple(p.shape[:-1])
+    g, kept = _grouped(xp, p, axes, 1)
+    _check_count(g, "poses")
+    w, total = _weights(xp, weights, batch, axes, p)
+    t = _average(xp, g[..., 4:], w, total)
+    mean = xp.concat([_chordal(xp, g[..., :4], w), t], axis=-1)
+    iterations = 0
+    if method == "geodesic":
+        tol = _tol(tol, p.dtype)
+        for iterations in range(1, max_iter + 1):  # noqa: B007
+            rel = _kse3.pose_compose(_kse3.pose_inv(mean)[..., None, :], g)
+            step = _average(xp, _kse3.twist_from_pose(rel), w, total)
+            mean = _kse3.pose_compose(mean, _kse3.pose_from_twist(step))
+            if _converged(xp, step, tol):
+                break
+        else:
+            _warn_unconverged(max_iter, tol)
+    elif method != "chordal":
+        raise ValueError(f"method must be 'chordal' or 'geodesic', got {method!r}")
+    return xp.concat(
+        [_kq.quat_canonical(mean[..., :4]), mean[..., 4:]], axis=-1
+    ), iterations
+
+
+def _average(xp, x, w, total):
+    """Weighted mean over the K axis of x (kept, K, c)."""
+    if w is None:
+        return xp.sum(x, axis=-2) / x.shape[-2]
+    return xp.sum(x * w[..., None], axis=-2) / total[..., None]
+
+
+def _tol(tol, dtype):
+    if tol is not None:
+        return float(tol)
+    return GEODESIC_TOL_32 if is_float32(dtype) else GEODESIC_TOL
+
+
+def _converged(xp, step, tol) -> bool:
+    return float(xp.max(xp.sqrt(xp.sum(step * step, axis=-1)))) <= tol
+
+
+def _warn_unconverged(max_iter, tol):
+    warnings.warn(
+        f"the Karcher mean did not converge to {tol:g} in {max_iter} steps "
+        "(the data may be spread over more than a hemisphere); returning the last iterate",
+        ConvergenceWarning,
+        stacklevel=3,
+    )

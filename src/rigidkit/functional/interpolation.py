@@ -1,0 +1,175 @@
+"""Geodesic interpolation and powers on SO(3) and SE(3), arrays in and out.
+
+Quaternions are Hamilton, scalar first ``(w, x, y, z)``; poses are
+``(w, x, y, z, tx, ty, tz)``. The geodesic from ``X0`` (at ``t = 0``) to ``X1``
+(at ``t = 1``) is ``X0 (X0^-1 X1)^t`` with ``X^t = exp(t log X)`` and the log's
+angle in [0, pi]: the shortest path, whatever the quaternion signs. Batch shapes
+of the two ends and of ``t`` broadcast; the array namespace and dtype are kept.
+
+>>> import numpy as np
+>>> q0 = np.array([1.0, 0.0, 0.0, 0.0])
+>>> q1 = np.array([0.0, 0.0, 0.0, 1.0])              # half turn about z
+>>> np.round(quat_slerp(q0, q1, 0.5), 12)            # quarter turn about z
+array([0.70710678, 0.        , 0.        , 0.70710678])
+"""
+
+from __future__ import annotations
+
+from .._engine.namespace import namespace_of
+from .._validate import as_array, as_float, finite_array
+from ..kernels import geodesic as _k
+from . import conversions as _conv
+
+__all__ = [
+    "quat_power",
+    "quat_slerp",
+    "pose_power",
+    "pose_slerp",
+    "quat_power_unchecked",
+    "quat_slerp_unchecked",
+    "pose_power_unchecked",
+    "pose_slerp_unchecked",
+    "segment_index",
+]
+
+
+def _unit_quat(q, what):
+    return _conv.quat_normalize(as_float(as_array(q, (4,), what)), what=what)
+
+
+def _pose(p, what):
+    """A pose with its quaternion normalised (validated)."""
+    p = as_float(finite_array(p, (7,), what))
+    q = _conv.quat_normalize(p[..., :4], what=f"{what} quaternion")
+    return namespace_of(p).concat([q, p[..., 4:]], axis=-1)
+
+
+def _fraction(t):
+    return as_float(finite_array(t, (), "interpolation parameter t"))
+
+
+def quat_power(q, t):
+    """``q^t = exp(t log q)``: the rotation about the same axis by ``t`` times the angle.
+
+    Parameters
+    ----------
+    q : array_like, shape (..., 4)
+        Quaternions (normalised here), scalar first.
+    t : array_like, shape (...)
+        Exponents; broadcasts with the batch shape of ``q``.
+
+    Returns
+    -------
+    ndarray, shape (..., 4)
+        Unit quaternions; ``q^0`` is the identity, ``q^-1`` the inverse.
+
+    >>> np.round(quat_power([0.0, 0.0, 0.0, 1.0], 0.5), 12)   # half of a half turn
+    array([0.70710678, 0.        , 0.        , 0.70710678])
+    """
+    return _k.quat_power(_unit_quat(q, "quaternion"), _fraction(t))
+
+
+def quat_slerp(q0, q1, t):
+    """Spherical linear interpolation ``q0 (q0* q1)^t``, shortest path.
+
+    Parameters
+    ----------
+    q0, q1 : array_like, shape (..., 4)
+        End quaternions (normalised here), scalar first; ``q1`` and ``-q1`` give
+        the same rotations.
+    t : array_like, shape (...)
+        Fractions: 0 gives ``q0`` exactly, 1 the rotation ``q1``; values outside
+        [0, 1] extrapolate along the geodesic.
+
+    Returns
+    -------
+    ndarray, shape (..., 4)
+    """
+    a = _unit_quat(q0, "quaternion q0")
+    b = _unit_quat(q1, "quaternion q1")
+    return _k.quat_slerp(a, b, _fraction(t))
+
+
+def pose_power(pose, t):
+    """``T^t = exp(t log T)`` of poses ``(w, x, y, z, tx, ty, tz)``: the screw scaled by t.
+
+    Parameters
+    ----------
+    pose : array_like, shape (..., 7)
+    t : array_like, shape (...)
+
+    Returns
+    -------
+    ndarray, shape (..., 7)
+    """
+    return _k.pose_power(_pose(pose, "pose"), _fraction(t))
+
+
+def pose_slerp(pose0, pose1, t, *, decoupled=False):
+    """Interpolate poses ``(w, x, y, z, tx, ty, tz)`` along the SE(3) geodesic.
+
+    The default is the screw motion ``T0 (T0^-1 T1)^t`` (constant body twist);
+    ``decoupled=True`` interpolates the rotation by slerp and the translation
+    linearly, ``(1 - t) t0 + t t1`` (a straight line for the origin).
+
+    Parameters
+    ----------
+    pose0, pose1 : array_like, shape (..., 7)
+    t : array_like, shape (...)
+
+    Returns
+    -------
+    ndarray, shape (..., 7)
+    """
+    a = _pose(pose0, "pose0")
+    b = _pose(pose1, "pose1")
+    return pose_slerp_unchecked(a, b, t, decoupled=decoupled)
+
+
+# The ``*_unchecked`` variants take ends known to be unit quaternions / valid poses
+# (the storage of Rotation and Transform) and check only ``t``.
+
+
+def quat_power_unchecked(q, t):
+    """:func:`quat_power` of a unit quaternion (not checked); ``t`` is checked."""
+    return _k.quat_power(q, _fraction(t))
+
+
+def quat_slerp_unchecked(q0, q1, t):
+    """:func:`quat_slerp` of unit quaternions (not checked); ``t`` is checked."""
+    return _k.quat_slerp(q0, q1, _fraction(t))
+
+
+def pose_power_unchecked(pose, t):
+    """:func:`pose_power` of a valid pose (not checked); ``t`` is checked."""
+    return _k.pose_power(pose, _fraction(t))
+
+
+def pose_slerp_unchecked(pose0, pose1, t, *, decoupled=False):
+    """:func:`pose_slerp` of valid poses (not checked); ``t`` is checked."""
+    kernel = _k.pose_slerp_decoupled if decoupled else _k.pose_slerp
+    return kernel(pose0, pose1, _fraction(t))
+
+
+def segment_index(knots, times):
+    """Index ``i`` of the interval ``[knots[i], knots[i + 1]]`` holding each time.
+
+    scipy's convention: intervals are closed on the right except that the first
+    knot belongs to interval 0, so an interior knot ``knots[k]`` falls in interval
+    ``k - 1`` (at its end). NumPy-side (``searchsorted`` on concrete values).
+
+    Parameters
+    ----------
+    knots : ndarray, shape (n,)
+        Strictly increasing.
+    times : ndarray, shape (...)
+        Within ``[knots[0], knots[-1]]`` (the caller checks).
+
+    Returns
+    -------
+    ndarray of intp, shape (...)
+    """
+    import numpy as np
+
+    idx = np.searchsorted(knots, times, side="left") - 1
+    return np.clip(idx, 0, len(knots) - 2)
