@@ -21,9 +21,9 @@ namespace); the Karcher loop tests convergence on concrete values (NumPy-side),
 so it does not trace under ``jax.jit``.
 
 >>> import numpy as np
->>> q = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0]])   # identity, half turn
->>> mean = quat_mean(np.array([[0.9, 0.0, 0.0, 0.1], [-0.9, 0.0, 0.0, 0.1]]))
->>> np.round(mean / mean[0], 12) + 0.0                          # about z, 0 deg
+>>> c, s = np.cos(0.1), np.sin(0.1)
+>>> mean, steps = quat_mean([[c, 0.0, 0.0, s], [-c, 0.0, 0.0, s]])  # +-0.2 rad about z
+>>> np.round(mean, 12) + 0.0
 array([1., 0., 0., 0.])
 """
 

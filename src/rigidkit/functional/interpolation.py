@@ -63,6 +63,7 @@ def quat_power(q, t):
     ndarray, shape (..., 4)
         Unit quaternions; ``q^0`` is the identity, ``q^-1`` the inverse.
 
+    >>> import numpy as np
     >>> np.round(quat_power([0.0, 0.0, 0.0, 1.0], 0.5), 12)   # half of a half turn
     array([0.70710678, 0.        , 0.        , 0.70710678])
     """
