@@ -16,6 +16,7 @@ from .errors import (
     NotARigidTransformError,
     NotARotationError,
     NotASimilarityError,
+    OutOfRangeError,
     PointAtInfinityError,
     RigidkitError,
     ShapeError,
@@ -41,6 +42,13 @@ _LAZY = {
     "se2": ("functional.se2", None),
     "sim3": ("functional.sim3", None),
     "symbolic": ("applications.symbolic", None),
+    "slerp": ("applications.interpolation", "slerp"),
+    "Slerp": ("applications.interpolation", "Slerp"),
+    "RotationSpline": ("applications.splines", "RotationSpline"),
+    "BSplineSO3": ("applications.splines", "BSplineSO3"),
+    "BSplineSE3": ("applications.splines", "BSplineSE3"),
+    "align_vectors": ("applications.alignment", "align_vectors"),
+    "align_points": ("applications.alignment", "align_points"),
 }
 
 # The public module paths predate the layered tree (docs/architecture.md):
@@ -111,6 +119,14 @@ __all__ = [
     "Affine",
     "Projective",
     "Quaternion",
+    # interpolation, splines, alignment
+    "slerp",
+    "Slerp",
+    "RotationSpline",
+    "BSplineSO3",
+    "BSplineSE3",
+    "align_vectors",
+    "align_points",
     # functional layers
     "conversions",
     "euler",
@@ -134,6 +150,7 @@ __all__ = [
     "ShapeError",
     "EulerSequenceError",
     "DegenerateInputError",
+    "OutOfRangeError",
     "GimbalLockWarning",
     "ConvergenceWarning",
 ]

@@ -19,6 +19,7 @@ __all__ = [
     "SingularMatrixError",
     "PointAtInfinityError",
     "DegenerateInputError",
+    "OutOfRangeError",
     "GimbalLockWarning",
     "ConvergenceWarning",
 ]
@@ -97,6 +98,11 @@ class PointAtInfinityError(RigidkitError):
 class DegenerateInputError(RigidkitError):
     """The data do not determine the result: weights that sum to zero or are
     negative, too few (or collinear) points to fix a rotation, all-zero vectors."""
+
+
+class OutOfRangeError(RigidkitError):
+    """A query lies outside the domain of an interpolant (a time before the first
+    or after the last keyframe or knot)."""
 
 
 class GimbalLockWarning(UserWarning):

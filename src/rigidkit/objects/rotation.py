@@ -13,8 +13,10 @@ import math
 import numpy as np
 
 from .._validate import _to_numpy, as_array
+from ..functional import averaging as _avg
 from ..functional import conversions as _conv
 from ..functional import euler
+from ..functional import interpolation as _interp
 from ._batch import BatchedArray, batch_shape
 from .group import LieGroup
 
@@ -234,6 +236,35 @@ class Rotation(BatchedArray, LieGroup):
     def magnitude(self):
         """Rotation angle in [0, pi] (same as :attr:`angle`)."""
         return self.angle
+
+    # -- powers and means (rigidkit.functional.interpolation / averaging) ---------------
+    def __pow__(self, t):
+        """``R ** t = exp(t log R)``: ``t`` times the angle about the axis (scipy's).
+
+        ``t`` (array_like, shape (...)) broadcasts with the batch; ``R ** 0`` is the
+        identity and ``R ** -1`` the inverse.
+        """
+        return Rotation._wrap(_interp.quat_power_unchecked(self._quat, t))
+
+    def mean(
+        self, weights=None, *, method="chordal", axis=None, return_info=False, tol=None
+    ):
+        """Mean rotation along batch ``axis`` (default all), independent of ``q`` signs.
+
+        ``method="chordal"`` (scipy's): the rotation nearest the weighted mean
+        matrix; ``"geodesic"``: the Karcher mean, iterated until the norm of the mean
+        log is below ``tol`` (1e-12 rad; 1e-6 in float32). ``weights`` (shape (...),
+        >= 0) broadcast with the batch. ``return_info=True`` returns ``(mean, info)``,
+        ``info = {"iterations": k}``. See :func:`rigidkit.functional.averaging.quat_mean`.
+
+        >>> R = Rotation.from_rotvec([[0.0, 0.0, 0.1], [0.0, 0.0, -0.1]])
+        >>> np.round(R.mean().as_rotvec(), 12) + 0.0
+        array([0., 0., 0.])
+        """
+        q, k = _avg.quat_mean_unchecked(
+            self._quat, weights, method=method, axis=axis, tol=tol
+        )
+        return (Rotation._wrap(q), {"iterations": k}) if return_info else Rotation._wrap(q)
 
     # -- container protocol (shape, len, [], reshape, ...): BatchedArray ------------------
     def _repr_single(self):

@@ -12,7 +12,9 @@ import numpy as np
 
 from .._engine.namespace import device_of, namespace_of
 from .._validate import _to_numpy, as_array, finite_array
+from ..functional import averaging as _avg
 from ..functional import conversions as _conv
+from ..functional import interpolation as _interp
 from ..functional import se3 as _se3
 from ..kernels import se3 as _k
 from ._batch import BatchedArray, batch_shape
@@ -204,6 +206,36 @@ class Transform(BatchedArray, LieGroup):
         """
         angle, dist = pose_gap(self._pose, other._pose)
         return (angle <= atol) & (dist <= atol)
+
+    # -- powers and means (rigidkit.functional.interpolation / averaging) ---------------
+    def __pow__(self, t):
+        """``T ** t = exp(t log T)``: the screw motion scaled by ``t`` (scipy's).
+
+        ``t`` (array_like, shape (...)) broadcasts with the batch; ``T ** -1`` is the
+        inverse.
+        """
+        return Transform._wrap(_interp.pose_power_unchecked(self._pose, t))
+
+    def mean(
+        self, weights=None, *, method="chordal", axis=None, return_info=False, tol=None
+    ):
+        """Mean rigid motion along batch ``axis`` (default all), sign-independent.
+
+        ``method="chordal"``: the chordal mean rotation and the weighted mean
+        translation (the rigid motion nearest the mean 4x4 matrix);
+        ``"geodesic"``: the SE(3) exponential barycenter, iterated until the norm of
+        the mean twist ``(v, w)`` is below ``tol`` (1e-12; 1e-6 in float32).
+        ``weights``, ``axis`` and ``return_info`` as :meth:`Rotation.mean`.
+
+        >>> T = Transform.exp([[1.0, 0.0, 0.0, 0.0, 0.0, 0.1], [-1.0, 0.0, 0.0, 0.0, 0.0, -0.1]])
+        >>> np.round(T.mean(method="geodesic").log(), 12) + 0.0
+        array([0., 0., 0., 0., 0., 0.])
+        """
+        p, k = _avg.pose_mean_unchecked(
+            self._pose, weights, method=method, axis=axis, tol=tol
+        )
+        return (
+            (Transform._wrap(p), {"iterations": k}) if return_info else Transform._wrap(p)
 
     # -- container protocol (shape, len, [], reshape, ...): BatchedArray ------------------
     def _repr_single(self):
