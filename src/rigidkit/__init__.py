@@ -10,6 +10,8 @@ from .errors import (
     ConvergenceWarning,
     DegenerateInputError,
     EulerSequenceError,
+    FrameError,
+    GimbalLockError,
     GimbalLockWarning,
     NonFiniteError,
     NotAffineError,
@@ -49,6 +51,7 @@ _LAZY = {
     "BSplineSE3": ("applications.splines", "BSplineSE3"),
     "align_vectors": ("applications.alignment", "align_vectors"),
     "align_points": ("applications.alignment", "align_points"),
+    "kinematics": ("applications.kinematics", None),
 }
 
 # The public module paths predate the layered tree (docs/architecture.md):
@@ -69,6 +72,7 @@ _MODULE_ALIASES = {
         )
     },
     "symbolic": "applications.symbolic",
+    "kinematics": "applications.kinematics",
     "cli": "applications.cli",
 }
 
@@ -137,6 +141,7 @@ __all__ = [
     "se3",
     "sim3",
     "symbolic",
+    "kinematics",
     # errors and warnings
     "RigidkitError",
     "NotARotationError",
@@ -151,6 +156,8 @@ __all__ = [
     "EulerSequenceError",
     "DegenerateInputError",
     "OutOfRangeError",
+    "GimbalLockError",
+    "FrameError",
     "GimbalLockWarning",
     "ConvergenceWarning",
 ]

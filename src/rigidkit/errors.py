@@ -20,6 +20,8 @@ __all__ = [
     "PointAtInfinityError",
     "DegenerateInputError",
     "OutOfRangeError",
+    "GimbalLockError",
+    "FrameError",
     "GimbalLockWarning",
     "ConvergenceWarning",
 ]
@@ -98,6 +100,36 @@ class PointAtInfinityError(RigidkitError):
 class DegenerateInputError(RigidkitError):
     """The data do not determine the result: weights that sum to zero or are
     negative, too few (or collinear) points to fix a rotation, all-zero vectors."""
+
+
+class GimbalLockError(RigidkitError):
+    """Euler-angle rates were asked for at (or too near) gimbal lock.
+
+    There the Euler-rate matrix ``E`` (``omega = E @ rates``) is singular: only
+    the sum or difference of the first and third rate is determined, and the
+    rates grow as ``1 / distance``. ``distance`` is the angle (radians) from the
+    middle angle to the lock, ``tolerance`` the smallest accepted; both are in
+    the message too.
+    """
+
+    def __init__(self, message="", *, index=None, distance=None, tolerance=None):
+        super().__init__(message, index=index)
+        self.distance = distance
+        self.tolerance = tolerance
+
+    def __reduce__(self):
+        return (
+            _rebuild_lock_error,
+            (type(self), str(self), self.index, self.distance, self.tolerance),
+        )
+
+
+def _rebuild_lock_error(cls, message, index, distance, tolerance):
+    return cls(message, index=index, distance=distance, tolerance=tolerance)
+
+
+class FrameError(RigidkitError):
+    """A velocity's frame is missing or not one of ``"world"`` and ``"body"``."""
 
 
 class OutOfRangeError(RigidkitError):

@@ -16,6 +16,7 @@ from ..functional import averaging as _avg
 from ..functional import conversions as _conv
 from ..functional import interpolation as _interp
 from ..functional import se3 as _se3
+from ..functional import screw as _screw
 from ..kernels import se3 as _k
 from ._batch import BatchedArray, batch_shape
 from .group import LieGroup
@@ -243,6 +244,41 @@ class Transform(BatchedArray, LieGroup):
         q = ", ".join(f"{c:.6g}" for c in p[:4])
         t = ", ".join(f"{c:.6g}" for c in p[4:])
         return f"Transform(rotation=Rotation.from_quat([{q}]), translation=[{t}])"
+
+    # -- screws (Chasles): see rigidkit.functional.screw ---------------------------------
+    @classmethod
+    def from_screw(cls, point, direction, pitch, angle):
+        """The screw motion: turn by ``angle`` about an axis, slide ``pitch * angle`` along it.
+
+        The axis passes through ``point`` along ``direction`` (any nonzero length;
+        turning right-handed about it). ``pitch`` is length per radian; with
+        ``pitch=inf`` the motion is a pure translation by ``angle`` (a length)
+        along ``direction``. Equals ``Transform.exp(V)`` with ``V = (q x w + h w,
+        w)``, ``w = angle * u``. Shapes (..., 3), (..., 3), (...), (...) broadcast.
+
+        >>> T = Transform.from_screw([1.0, 0.0, 0.0], [0.0, 0.0, 1.0], 0.5, np.pi)
+        >>> np.round(T @ np.array([0.0, 0.0, 0.0]), 12) + 0.0
+        array([2.        , 0.        , 1.57079633])
+
+        See Also
+        --------
+        as_screw : the inverse.
+        """
+        return cls.exp(_screw.twist_from_screw(point, direction, pitch, angle))
+
+    def as_screw(self):
+        """Screw parameters ``(point, direction, pitch, angle)`` of :meth:`log`.
+
+        ``angle`` in [0, pi]; ``point`` is the axis point nearest the origin; a pure
+        translation has ``pitch = inf``, ``angle`` its length and ``direction``
+        its direction. See :func:`rigidkit.functional.screw.screw_from_twist`.
+
+        >>> T = Transform.from_screw([1.0, 0.0, 0.0], [0.0, 0.0, 1.0], 0.5, 1.0)
+        >>> q, u, h, angle = T.as_screw()
+        >>> np.round(q, 12) + 0.0, u, float(np.round(h, 12)), float(np.round(angle, 12))
+        (array([1., 0., 0.]), array([0., 0., 1.]), 0.5, 1.0)
+        """
+        return _screw.screw_from_twist(self.log())
 
 
 def pose_gap(a, b):

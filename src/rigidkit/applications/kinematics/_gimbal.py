@@ -1,0 +1,46 @@
+"""The gimbal-lock check of the inverse Euler-rate functions."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..._validate import batch_index, where_text
+from ...errors import GimbalLockError
+
+
+def _host(a):
+    if isinstance(a, np.ndarray):
+        return a
+    if hasattr(a, "detach"):
+        return a.detach().cpu().numpy()
+    return np.asarray(a)
+
+
+def check_lock(distance, tol: float, seq, fn: str) -> None:
+    """Raise :class:`GimbalLockError` where ``distance`` (radians) is below ``tol``.
+
+    ``distance`` is the kernel's angle from the middle angle to the lock. Under
+    tracing (``jax.jit``: no concrete values) the check is skipped and the rates
+    come out large but finite.
+    """
+    try:
+        d = _host(distance)
+    except Exception:  # a tracer: no concrete value to check
+        return
+    if d.size == 0 or float(d.min()) >= tol:
+        return
+    bad = d < tol
+    idx = batch_index(bad)
+    dist = float(d[idx]) if idx else float(d)
+    lock = "0 or pi" if seq.proper else "+-pi/2"
+    raise GimbalLockError(
+        f"{fn}: gimbal lock in {seq.text!r}: the middle angle {where_text(idx)} is "
+        f"{dist:.3g} rad from {lock}, closer than the tolerance {tol:.3g} rad "
+        f"({int(bad.sum())} of {max(bad.size, 1)} inputs). There the Euler-rate "
+        f"matrix is singular (only the sum or difference of the first and third "
+        f"rate is determined); use quaternions or rotation vectors near the lock, "
+        f"or pass a smaller tol=.",
+        index=idx,
+        distance=dist,
+        tolerance=tol,
+    )

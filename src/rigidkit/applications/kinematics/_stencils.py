@@ -1,0 +1,150 @@
+"""Rates between samples: Lagrange interpolation on the nearest samples.
+
+For step ``k`` (from ``t_k`` to ``t_k + dt_k``) the integrators need the rate at
+the middle and at the end of the step. Order 2 interpolates linearly between
+samples ``k`` and ``k + 1`` (the last step extrapolates from the last two); order
+4 takes the cubic through the four nearest samples (``k - 1 ... k + 2``, shifted
+inwards at the ends). The end of a step other than the last is sample ``k + 1``
+itself, which the interpolation returns exactly (its weight is 1, the others 0).
+
+Node times are formed relative to ``t_k`` from the few step durations between
+them, not as differences of absolute times, so long logs lose no digits.
+The weights are computed on the host in float64 (NumPy) and applied in the
+rates' own namespace (gradients flow with respect to the rates, not ``dt``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..._engine.namespace import device_of, is_numpy, namespace_of
+from ...errors import DegenerateInputError
+
+
+def _host(a):
+    if isinstance(a, np.ndarray):
+        return a
+    if hasattr(a, "detach"):
+        return a.detach().cpu().numpy()
+    return np.asarray(a)
+
+
+def _node_offsets(d, m: int):
+    """``t_{j0(k) + i} - t_k`` for ``i < m``, from the step durations ``d`` (..., N)."""
+    n = d.shape[-1]
+    k = np.arange(n)
+    j0 = np.clip(k - (m // 2 - 1), 0, n - m)
+    pad = np.zeros(d.shape[:-1] + (m,))
+    p = np.concatenate([pad, d, pad], axis=-1)  # p[..., k + m + l] = d_{k+l}
+    # offset(k, s) for s = j - k in [-(m-1), m-1], column s + m - 1
+    cols = [None] * (2 * m - 1)
+    cols[m - 1] = np.zeros(d.shape)
+    for s in range(1, m):
+        cols[m - 1 + s] = cols[m - 2 + s] + p[..., k + m + s - 1]
+        cols[m - 1 - s] = cols[m - s] - p[..., k + m - s]
+    table = np.stack(cols, axis=-1)
+    s_idx = (j0[:, None] + np.arange(m)[None, :]) - k[:, None] + (m - 1)  # (N, m)
+    offs = np.take_along_axis(table, np.broadcast_to(s_idx, table.shape[:-1] + (m,)), -1)
+    return j0, offs
+
+
+def _lagrange(offs, x):
+    """Weights ``L_i(x)`` of the nodes ``offs`` (..., N, m) at ``x`` (..., N)."""
+    m = offs.shape[-1]
+    w = []
+    for i in range(m):
+        num = np.ones(offs.shape[:-1])
+        den = np.ones(offs.shape[:-1])
+        for j in range(m):
+            if j != i:
+                num = num * (x - offs[..., j])
+                den = den * (offs[..., i] - offs[..., j])
+        w.append(num / den)
+    return np.stack(w, axis=-1)
+
+
+def rates_at_step_points(rate, h, *, order: int):
+    """Rates at the middle and the end of every step, shape of ``rate`` (..., N, W).
+
+    ``h`` is the step duration, shape () (uniform) or (..., N).
+    """
+    n = rate.shape[-2]
+    m = 2 if order == 2 else 4
+    if n < m:
+        raise DegenerateInputError(
+            f"the {'midpoint' if m == 2 else 'rk4'} method needs at least {m} samples "
+            f"to interpolate the rate, got {n} (use method='exact')"
+        )
+    hh = _host(h).astype(np.float64)
+    xp = namespace_of(rate)
+    numpy = is_numpy(xp)
+
+    def conv(a):
+        if numpy:
+            return np.asarray(a, dtype=rate.dtype)
+        return xp.asarray(a, dtype=rate.dtype, device=device_of(rate))
+
+    def rows(idx):
+        return (
+            rate[..., idx, :]
+            if numpy
+            else rate[..., xp.asarray(idx, device=device_of(rate)), :]
+        )
+
+    if hh.ndim == 0 and n > m:
+        return _uniform(rate, n, m, conv, rows, xp)
+    # Lagrange weights do not change when all steps scale alike.
+    d = np.ones(n) if hh.ndim == 0 else hh
+    if np.any(d <= 0):
+        raise DegenerateInputError("step durations dt must be positive")
+    j0, offs = _node_offsets(d, m)
+    w_mid = conv(_lagrange(offs, 0.5 * d))
+    w_end = conv(_lagrange(offs, d))
+    mid = 0.0
+    end = 0.0
+    for i in range(m):
+        node = rows(j0 + i)
+        mid = mid + w_mid[..., i, None] * node
+        end = end + w_end[..., i, None] * node
+    return mid, end
+
+
+def _uniform(rate, n, m, conv, rows, xp):
+    """Uniform steps: the same weights on every interior window, applied by slicing.
+
+    The weights are those of :func:`_lagrange` on unit steps for the ``m`` window
+    positions (a step at a window's start, middle or end); only the first and
+    last steps use shifted windows. The end of step ``k < N - 1`` is sample
+    ``k + 1``.
+    """
+    small = m + 1  # every window position occurs in m + 1 unit steps
+    d = np.ones(small)
+    j0, offs = _node_offsets(d, m)
+    w_mid = _lagrange(offs, 0.5 * d)  # (small, m)
+    w_end = _lagrange(offs, d)
+    lead = m // 2 - 1  # steps before the first interior one
+    inner = w_mid[lead]
+    count = n - m + 1  # interior steps: k = lead ... lead + count - 1
+    mid_inner = 0.0
+    for i in range(m):
+        mid_inner = mid_inner + float(inner[i]) * rate[..., i : i + count, :]
+    pieces = []
+    head = rows(np.arange(m))
+    for k in range(lead):
+        pieces.append(_weighted(w_mid[k], head, conv))
+    pieces.append(mid_inner)
+    tail = rows(np.arange(n - m, n))
+    for c in range(lead + 1, m):  # the last m - lead - 1 steps, window at the end
+        pieces.append(_weighted(w_mid[small - m + c], tail, conv))
+    mid = xp.concat(pieces, axis=-2)
+    last = _weighted(w_end[small - 1], tail, conv)
+    end = xp.concat([rate[..., 1:, :], last], axis=-2)
+    return mid, end
+
+
+def _weighted(w, nodes, conv):
+    """``sum_i w[i] nodes[..., i, :]`` as shape (..., 1, W)."""
+    out = 0.0
+    for i in range(nodes.shape[-2]):
+        out = out + float(w[i]) * nodes[..., i : i + 1, :]
+    return out

@@ -1,0 +1,206 @@
+"""Integration of sampled angular velocity and twists into trajectories.
+
+Sample ``k`` of the rate is its value at ``t_k = dt_0 + ... + dt_{k-1}``, the start
+of step ``k``; ``N`` samples give ``N`` steps and ``N + 1`` orientations (the
+first is the initial one). Methods (see :mod:`rigidkit.kernels.kinematics_integration`):
+
+``"exact"``
+    Zero-order hold: the rate is held over each step, ``R_{k+1} = R_k exp(w_k dt_k)``
+    (body). Exact for piecewise-constant rates (what a gyroscope reporting mean
+    rates per sample measures), first order for smooth ones.
+``"midpoint"``
+    The rate at the middle of the step, linearly interpolated between samples (or
+    extrapolated from the last two): second order for a smooth rate.
+``"rk4"``
+    Runge-Kutta-Munthe-Kaas of order 4, the rates at the middle and end of the
+    step from the cubic through the four nearest samples: fourth order.
+
+Every step is an exponential and the running product is renormalised each step,
+so the orientations are unit quaternions to rounding over any length, and a
+constant rate gives ``exp(w t)`` with every method.
+
+The increments of all steps are computed at once (they do not depend on the
+orientation: batched kernels, fused numba loops on NumPy); only their running
+product is sequential: a compiled numba loop on NumPy (3.6 M steps, an hour at
+1 kHz, take well under a second), a parallel prefix product on torch, JAX and
+NumPy without numba (see :mod:`._scan`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..._engine.namespace import device_of, is_numpy, namespace_of
+from ..._validate import finite_array
+from ...errors import ShapeError
+from ...kernels import kinematics_integration as _k
+from ...objects.rotation import Rotation
+from ...objects.transform import Transform
+from ._common import body_flag, homogeneous_matrix, rotation_matrix
+from ._scan import running_product
+from ._stencils import rates_at_step_points
+
+__all__ = ["integrate_angular_velocity", "integrate_twist"]
+
+_METHODS = ("exact", "midpoint", "rk4")
+
+
+def _method(method, fn):
+    if method not in _METHODS:
+        raise ValueError(f"{fn}: method must be one of {_METHODS}, got {method!r}")
+    return method
+
+
+def _steps(dt, rate, fn):
+    """Step durations as an array of the rate's namespace, shape () or (..., N)."""
+    n = rate.shape[-2]
+    xp = namespace_of(rate)
+    h = finite_array(dt, (), "dt") if not hasattr(dt, "shape") or dt.ndim == 0 else dt
+    h = finite_array(h, (), "dt")
+    if h.ndim and h.shape[-1] != n:
+        raise ShapeError(
+            f"{fn}: dt has {h.shape[-1]} step times on its last axis, the rates {n} "
+            f"samples (one step per sample; pass a scalar for uniform steps)"
+        )
+    if is_numpy(xp):
+        h = np.asarray(h, dtype=rate.dtype)
+    else:
+        h = xp.asarray(h, dtype=rate.dtype, device=device_of(rate))
+    return h
+
+
+def _increments(kind, body, method, rate, h):
+    """The per-step group elements (quaternions or poses), shape (..., N, W)."""
+    one, rk4 = (
+        (_k.so3_increment, _k.so3_increment_rk4)
+        if kind == "so3"
+        else (_k.se3_increment, _k.se3_increment_rk4)
+    )
+    if method == "exact":
+        return one(rate, h)
+    mid, end = rates_at_step_points(rate, h, order=2 if method == "midpoint" else 4)
+    if method == "midpoint":
+        return one(mid, h)
+    return rk4(body, rate, mid, end, h)
+
+
+def _samples(rate, width, what, fn):
+    r = finite_array(rate, (width,), what)
+    if r.ndim < 2:
+        raise ShapeError(f"{fn}: {what} must have shape (..., N, {width}), got {r.shape}")
+    if isinstance(r, np.ndarray) and r.dtype.kind != "f":
+        r = r.astype(np.float64)
+    return r
+
+
+def integrate_angular_velocity(R0, omega, dt, *, frame=None, method="exact"):
+    """Orientation trajectory of a body turning at the sampled rates ``omega``.
+
+    Body frame (gyroscope rates): ``R' = R hat(omega)``; world frame:
+    ``R' = hat(omega) R``. Sample ``k`` is the rate at the start of step ``k``.
+
+    Parameters
+    ----------
+    R0 : Rotation or array_like, shape (..., 3, 3)
+        Initial orientation ``W_R_B``.
+    omega : array_like, shape (..., N, 3)
+        Angular velocity samples, radians per unit time; the batch shape
+        broadcasts with that of ``R0`` (many trajectories at once).
+    dt : float or array_like, shape (N,) or (..., N)
+        Step durations (uniform, or one per sample).
+    frame : {"world", "body"}
+        Required.
+    method : {"exact", "midpoint", "rk4"}
+        Zero-order hold, second or fourth order (module docstring). "midpoint"
+        needs N >= 2 samples, "rk4" N >= 4.
+
+    Returns
+    -------
+    Rotation of shape (..., N + 1), or matrices (..., N + 1, 3, 3) when ``R0`` is
+    an array. Element 0 is ``R0``.
+
+    Examples
+    --------
+    A gyroscope log at 200 Hz, one second about z at pi/2 rad/s:
+
+    >>> import numpy as np
+    >>> import rigidkit as rk
+    >>> omega = np.tile([0.0, 0.0, np.pi / 2], (200, 1))
+    >>> R0 = rk.Rotation.identity()
+    >>> traj = integrate_angular_velocity(R0, omega, 1 / 200, frame="body")
+    >>> traj.shape
+    (201,)
+    >>> np.round(traj[-1].as_rotvec(), 12)
+    array([0.        , 0.        , 1.57079633])
+    """
+    fn = "integrate_angular_velocity"
+    body = body_flag(frame, fn)
+    _method(method, fn)
+    as_object = isinstance(R0, Rotation)
+    q0 = R0.as_quat() if as_object else Rotation.from_matrix(rotation_matrix(R0)).as_quat()
+    w = _samples(omega, 3, "angular velocity", fn)
+    h = _steps(dt, w, fn)
+    q0 = _like(q0, w)
+    dq = _increments("so3", body, method, w, h)
+    q = running_product(_k.so3_chain, body, q0, dq)
+    traj = Rotation._wrap(q)
+    return traj if as_object else traj.as_matrix()
+
+
+def integrate_twist(T0, twist, dt, *, frame=None, method="exact"):
+    """Pose trajectory of a body moving with the sampled twists ``(v, omega)``.
+
+    Body frame (dead reckoning from velocities measured on the vehicle, ``v`` the
+    velocity of its origin in its own axes): ``T' = T hat(V)``; world frame:
+    ``T' = hat(V) T``. Methods and sampling as in
+    :func:`integrate_angular_velocity`; the steps are ``exp`` of se(3).
+
+    Parameters
+    ----------
+    T0 : Transform or array_like, shape (..., 4, 4)
+        Initial pose ``W_T_B``.
+    twist : array_like, shape (..., N, 6)
+        Twist samples ``(v, omega)``.
+    dt : float or array_like, shape (N,) or (..., N)
+    frame : {"world", "body"}
+    method : {"exact", "midpoint", "rk4"}
+
+    Returns
+    -------
+    Transform of shape (..., N + 1), or matrices (..., N + 1, 4, 4) when ``T0`` is
+    an array.
+
+    Examples
+    --------
+    Driving a quarter circle of radius 1: forward at 1, turning left at 1 rad/s.
+
+    >>> import numpy as np
+    >>> import rigidkit as rk
+    >>> V = np.tile([1.0, 0, 0, 0, 0, 1.0], (100, 1))
+    >>> traj = integrate_twist(rk.Transform.identity(), V, np.pi / 200, frame="body")
+    >>> np.round(traj[-1].translation, 12)
+    array([1., 1., 0.])
+    """
+    fn = "integrate_twist"
+    body = body_flag(frame, fn)
+    _method(method, fn)
+    as_object = isinstance(T0, Transform)
+    if as_object:
+        p0 = T0._pose
+    else:
+        p0 = Transform.from_matrix(homogeneous_matrix(T0))._pose
+    V = _samples(twist, 6, "twist", fn)
+    h = _steps(dt, V, fn)
+    p0 = _like(p0, V)
+    dp = _increments("se3", body, method, V, h)
+    p = running_product(_k.se3_chain, body, p0, dp)
+    traj = Transform._wrap(p)
+    return traj if as_object else traj.as_matrix()
+
+
+def _like(x0, rate):
+    """``x0`` in the namespace, dtype and device of the rates."""
+    xp = namespace_of(rate)
+    if is_numpy(xp):
+        return np.asarray(x0, dtype=np.result_type(x0.dtype, rate.dtype))
+    return xp.asarray(x0, dtype=rate.dtype, device=device_of(rate))

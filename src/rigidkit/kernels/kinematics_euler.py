@@ -1,0 +1,347 @@
+"""Kernels of Euler-angle kinematics: the rate matrix ``E``, its inverse and ``dE/dt``.
+
+``omega = E(angles) @ d(angles)/dt`` with the angles and rates in the sequence's
+own order, ``omega`` the angular velocity in the world frame (``vee(R' R^T)``) or the
+body frame (``vee(R^T R')``). One kernel serves all 24 sequences, with the static
+parameters of :mod:`.euler` (``e1, e2, parity, proper, reverse``; matrix-product
+order ``R = R_e1(t1) R_e2(t2) R_e3(t3)``) and ``body`` (0 world, 1 body).
+
+Derivation. With ``a_k`` the unit axis of factor ``k`` and ``R_k`` the factor,
+``R' R^T = t1' hat(a1) + t2' R_1 hat(a2) R_1^T + t3' R_1 R_2 hat(a3) (R_1 R_2)^T``,
+so the columns of ``E`` (product order) are, in the world frame,
+``c1 = a1, c2 = R_1 a2, c3 = R_1 R_2 a3``, and in the body frame
+``b1 = (R_2 R_3)^T a1, b2 = R_3^T a2, b3 = a3``. In the permuted coordinates
+``p = (v[e1], v[e2], v[m])`` (``m`` the third axis) every sequence is the cyclic
+one, ``xyz`` or ``xyx``, with each angle multiplied by ``parity`` (a permutation
+of odd parity reverses the sense of turning); since both ``omega`` and the axes
+are permuted alike, the sign cancels in ``E`` itself (``P omega = E_xyz(parity t)
+t'``). With ``S_k = parity sin t_k``, ``C_k = cos t_k`` the columns are:
+
+=================  =====================  =====================
+                   Tait-Bryan (xyz)       proper (xyx)
+=================  =====================  =====================
+world ``c1``       ``(1, 0, 0)``          ``(1, 0, 0)``
+world ``c2``       ``(0, C1, S1)``        ``(0, C1, S1)``
+world ``c3``       ``(S2, -S1 C2, C1 C2)`` ``(C2, S1 S2, -C1 S2)``
+body ``b1``        ``(C2 C3, -C2 S3, S2)`` ``(C2, S2 S3, S2 C3)``
+body ``b2``        ``(S3, C3, 0)``        ``(0, C3, -S3)``
+body ``b3``        ``(0, 0, 1)``          ``(1, 0, 0)``
+=================  =====================  =====================
+
+(the notes' XYZ space-frame matrix, 000 D.2, is the world Tait-Bryan column set).
+``det E = C2`` (Tait-Bryan) or ``S2`` (proper) up to sign: ``E`` is singular at
+gimbal lock, a middle angle of ``+-pi/2`` or ``0, pi``.
+
+The derivative of a column is a cross product (each column is a fixed axis turned
+by the factors before it): world ``c2' = t1' c1 x c2``, ``c3' = (t1' c1 + t2' c2)
+x c3``; body ``b2' = -t3' b3 x b2``, ``b1' = -(t3' b3 + t2' b2) x b1``; in the
+permuted coordinates the turning rates carry the parity too. ``E'`` is exact, no
+finite difference.
+"""
+
+from .._engine import helper, kernel
+from .so3_jacobians import cross3  # noqa: F401  (bound by name)
+
+
+@helper
+def euler_product_order(reverse, a0, a1, a2):
+    """``(t1, t2, t3)`` in matrix-product order from values in sequence order."""
+    rev = reverse == 1
+    return (where(rev, a2, a0), a1, where(rev, a0, a2))
+
+
+@helper
+def euler_rate_columns(parity, proper, body, t1, t2, t3):
+    """The 9 entries of ``E`` in permuted coordinates, column by column (product order).
+
+    See the module docstring for the table.
+    """
+    s1 = parity * sin(t1)
+    c1 = cos(t1)
+    s2 = parity * sin(t2)
+    c2 = cos(t2)
+    s3 = parity * sin(t3)
+    c3 = cos(t3)
+    pr = proper == 1
+    world = (
+        1.0, 0.0, 0.0,
+        0.0, c1, s1,
+        where(pr, c2, s2), where(pr, s1 * s2, -s1 * c2), where(pr, -c1 * s2, c1 * c2),
+    )  # fmt: skip
+    bod = (
+        where(pr, c2, c2 * c3), where(pr, s2 * s3, -c2 * s3), where(pr, s2 * c3, s2),
+        where(pr, 0.0, s3), c3, where(pr, -s3, 0.0),
+        where(pr, 1.0, 0.0), 0.0, where(pr, 0.0, 1.0),
+    )  # fmt: skip
+    b = body == 1
+    return (
+        where(b, bod[0], world[0]),
+        where(b, bod[1], world[1]),
+        where(b, bod[2], world[2]),
+        where(b, bod[3], world[3]),
+        where(b, bod[4], world[4]),
+        where(b, bod[5], world[5]),
+        where(b, bod[6], world[6]),
+        where(b, bod[7], world[7]),
+        where(b, bod[8], world[8]),
+    )
+
+
+@helper
+def euler_rate_column_derivatives(parity, proper, body, t1, t2, t3, r1, r2, r3):
+    """``dE/dt`` in permuted coordinates (column by column, product order).
+
+    ``r1, r2, r3`` are the angle rates in product order. Cross products of the
+    columns (module docstring); the permuted frame turns by ``parity * r``.
+    """
+    c = euler_rate_columns(parity, proper, body, t1, t2, t3)
+    u1 = parity * r1
+    u2 = parity * r2
+    u3 = parity * r3
+    # world: c2' = u1 c1 x c2, c3' = (u1 c1 + u2 c2) x c3
+    w2 = cross3(u1 * c[0], u1 * c[1], u1 * c[2], c[3], c[4], c[5])
+    w3 = cross3(
+        u1 * c[0] + u2 * c[3],
+        u1 * c[1] + u2 * c[4],
+        u1 * c[2] + u2 * c[5],
+        c[6],
+        c[7],
+        c[8],
+    )
+    # body: b2' = -u3 b3 x b2, b1' = -(u3 b3 + u2 b2) x b1
+    v2 = cross3(c[3], c[4], c[5], u3 * c[6], u3 * c[7], u3 * c[8])
+    v1 = cross3(
+        c[0],
+        c[1],
+        c[2],
+        u3 * c[6] + u2 * c[3],
+        u3 * c[7] + u2 * c[4],
+        u3 * c[8] + u2 * c[5],
+    )
+    b = body == 1
+    return (
+        where(b, v1[0], 0.0),
+        where(b, v1[1], 0.0),
+        where(b, v1[2], 0.0),
+        where(b, v2[0], w2[0]),
+        where(b, v2[1], w2[1]),
+        where(b, v2[2], w2[2]),
+        where(b, 0.0, w3[0]),
+        where(b, 0.0, w3[1]),
+        where(b, 0.0, w3[2]),
+    )
+
+
+@helper
+def euler_rate_inverse_rows(parity, proper, body, t1, t2, t3):
+    """``E^-1`` in permuted coordinates (row by row, product order) and ``det``.
+
+    Closed forms of the inverse of the columns' matrix (module docstring), with
+    ``1 / D``, ``D = C2`` (Tait-Bryan) or ``S2`` (proper), evaluated at a safe
+    denominator so the rows stay finite at the lock (the caller rejects it by the
+    returned ``D``).
+    """
+    s1 = parity * sin(t1)
+    c1 = cos(t1)
+    s2 = parity * sin(t2)
+    c2 = cos(t2)
+    s3 = parity * sin(t3)
+    c3 = cos(t3)
+    pr = proper == 1
+    d = where(pr, s2, c2)
+    k = 1.0 / where(abs(d) > 0.0, d, 1.0)
+    world = (
+        1.0, where(pr, -c2 * s1 * k, s1 * s2 * k), where(pr, c2 * c1 * k, -c1 * s2 * k),
+        0.0, c1, s1,
+        0.0, where(pr, s1 * k, -s1 * k), where(pr, -c1 * k, c1 * k),
+    )  # fmt: skip
+    bod = (
+        where(pr, 0.0, c3 * k), where(pr, s3 * k, -s3 * k), where(pr, c3 * k, 0.0),
+        where(pr, 0.0, s3), c3, where(pr, -s3, 0.0),
+        where(pr, 1.0, -s2 * c3 * k), where(pr, -c2 * s3 * k, s2 * s3 * k),
+        where(pr, -c2 * c3 * k, 1.0),
+    )  # fmt: skip
+    b = body == 1
+    return (
+        where(b, bod[0], world[0]),
+        where(b, bod[1], world[1]),
+        where(b, bod[2], world[2]),
+        where(b, bod[3], world[3]),
+        where(b, bod[4], world[4]),
+        where(b, bod[5], world[5]),
+        where(b, bod[6], world[6]),
+        where(b, bod[7], world[7]),
+        where(b, bod[8], world[8]),
+        d,
+    )
+
+
+@helper
+def lock_distance(d):
+    """Angle (radians) from the middle angle to the nearest lock, from ``D``.
+
+    ``D = cos t2`` (Tait-Bryan) or ``sin t2`` (proper) up to sign; the nearest
+    zero of ``cos`` (``sin``) is ``asin(|D|)`` away, exactly.
+    """
+    return asin(minimum(abs(d), 1.0))
+
+
+@helper
+def permuted_to_world_3(e1, e2, p0, p1, p2):
+    """Components on axes ``(x, y, z)`` of a vector given on ``(e1, e2, m)``."""
+    return (
+        where(e1 == 0, p0, where(e2 == 0, p1, p2)),
+        where(e1 == 1, p0, where(e2 == 1, p1, p2)),
+        where(e1 == 2, p0, where(e2 == 2, p1, p2)),
+    )
+
+
+@helper
+def matrix_entries_from_columns(e1, e2, reverse, scale, c):
+    """Row-major ``E`` on axes ``(x, y, z)`` and angles in sequence order.
+
+    ``c`` holds the columns in permuted coordinates and product order; the
+    sequence's first angle is the product's last for extrinsic sequences.
+    """
+    rev = reverse == 1
+    k0 = where(rev, 2, 0)
+    k2 = where(rev, 0, 2)
+    col0 = permuted_to_world_3(e1, e2, c[3 * k0], c[3 * k0 + 1], c[3 * k0 + 2])
+    col1 = permuted_to_world_3(e1, e2, c[3], c[4], c[5])
+    col2 = permuted_to_world_3(e1, e2, c[3 * k2], c[3 * k2 + 1], c[3 * k2 + 2])
+    return (
+        scale * col0[0], scale * col1[0], scale * col2[0],
+        scale * col0[1], scale * col1[1], scale * col2[1],
+        scale * col0[2], scale * col1[2], scale * col2[2],
+    )  # fmt: skip
+
+
+@helper
+def dot3(ax, ay, az, bx, by, bz):
+    """``a . b``."""
+    return ax * bx + ay * by + az * bz
+
+
+_PARAMS = ("e1", "e2", "parity", "proper", "reverse", "body", "scale")
+
+
+@kernel(inputs=[(3,)], outputs=[(3, 3)], params=_PARAMS)
+def rate_matrix_from_euler(e1, e2, parity, proper, reverse, body, scale, a0, a1, a2):
+    """``E`` with ``omega = E @ rates``, row-major; see the module docstring.
+
+    ``scale`` is radians per angle unit: the angles are multiplied by it, and so
+    is ``E`` (rates in degrees per unit time give ``omega`` in radians).
+    """
+    t1, t2, t3 = euler_product_order(reverse, a0 * scale, a1 * scale, a2 * scale)
+    c = euler_rate_columns(parity, proper, body, t1, t2, t3)
+    return matrix_entries_from_columns(e1, e2, reverse, scale, c)
+
+
+@kernel(inputs=[(3,), (3,)], outputs=[(3, 3)], params=_PARAMS)
+def rate_matrix_derivative_from_euler(
+    e1, e2, parity, proper, reverse, body, scale, a0, a1, a2, r0, r1, r2
+):
+    """``dE/dt`` for angles ``a`` changing at rates ``r`` (both in sequence order)."""
+    t1, t2, t3 = euler_product_order(reverse, a0 * scale, a1 * scale, a2 * scale)
+    u1, u2, u3 = euler_product_order(reverse, r0 * scale, r1 * scale, r2 * scale)
+    c = euler_rate_column_derivatives(parity, proper, body, t1, t2, t3, u1, u2, u3)
+    return matrix_entries_from_columns(e1, e2, reverse, scale, c)
+
+
+@kernel(inputs=[(3,)], outputs=[(3, 3), ()], params=_PARAMS)
+def rate_matrix_inverse_from_euler(
+    e1, e2, parity, proper, reverse, body, scale, a0, a1, a2
+):
+    """``E^-1`` (row-major; rows in sequence order, columns x, y, z) and the lock distance.
+
+    The second output is the angle (radians) from the middle angle to the nearest
+    gimbal lock; ``E^-1`` grows as its inverse, and callers reject it below their
+    tolerance. Rows are divided by ``scale`` (rates in the angles' unit).
+    """
+    t1, t2, t3 = euler_product_order(reverse, a0 * scale, a1 * scale, a2 * scale)
+    r = euler_rate_inverse_rows(parity, proper, body, t1, t2, t3)
+    rev = reverse == 1
+    k0 = where(rev, 2, 0)
+    k2 = where(rev, 0, 2)
+    inv = 1.0 / scale
+    row0 = permuted_to_world_3(e1, e2, r[3 * k0], r[3 * k0 + 1], r[3 * k0 + 2])
+    row1 = permuted_to_world_3(e1, e2, r[3], r[4], r[5])
+    row2 = permuted_to_world_3(e1, e2, r[3 * k2], r[3 * k2 + 1], r[3 * k2 + 2])
+    return (
+        inv * row0[0], inv * row0[1], inv * row0[2],
+        inv * row1[0], inv * row1[1], inv * row1[2],
+        inv * row2[0], inv * row2[1], inv * row2[2],
+        lock_distance(r[9]),
+    )  # fmt: skip
+
+
+@kernel(inputs=[(3,), (3,)], outputs=[(3,)], params=_PARAMS)
+def omega_from_euler_rates(
+    e1, e2, parity, proper, reverse, body, scale, a0, a1, a2, r0, r1, r2
+):
+    """``omega = E @ rates`` without forming ``E`` in memory."""
+    t1, t2, t3 = euler_product_order(reverse, a0 * scale, a1 * scale, a2 * scale)
+    u1, u2, u3 = euler_product_order(reverse, r0 * scale, r1 * scale, r2 * scale)
+    c = euler_rate_columns(parity, proper, body, t1, t2, t3)
+    p0 = c[0] * u1 + c[3] * u2 + c[6] * u3
+    p1 = c[1] * u1 + c[4] * u2 + c[7] * u3
+    p2 = c[2] * u1 + c[5] * u2 + c[8] * u3
+    return permuted_to_world_3(e1, e2, p0, p1, p2)
+
+
+@kernel(inputs=[(3,), (3,)], outputs=[(3,), ()], params=_PARAMS)
+def euler_rates_from_omega(
+    e1, e2, parity, proper, reverse, body, scale, a0, a1, a2, wx, wy, wz
+):
+    """``rates = E^-1 @ omega`` (sequence order) and the lock distance (radians)."""
+    t1, t2, t3 = euler_product_order(reverse, a0 * scale, a1 * scale, a2 * scale)
+    r = euler_rate_inverse_rows(parity, proper, body, t1, t2, t3)
+    w = (wx, wy, wz)
+    m = 3 - e1 - e2
+    p0 = w[e1]
+    p1 = w[e2]
+    p2 = w[m]
+    inv = 1.0 / scale
+    u1 = inv * dot3(r[0], r[1], r[2], p0, p1, p2)
+    u2 = inv * dot3(r[3], r[4], r[5], p0, p1, p2)
+    u3 = inv * dot3(r[6], r[7], r[8], p0, p1, p2)
+    rev = reverse == 1
+    return (where(rev, u3, u1), u2, where(rev, u1, u3), lock_distance(r[9]))
+
+
+@kernel(inputs=[(3,), (3,), (3,)], outputs=[(3,)], params=_PARAMS)
+def alpha_from_euler_accelerations(
+    e1, e2, parity, proper, reverse, body, scale, a0, a1, a2, r0, r1, r2, d0, d1, d2
+):
+    """Angular acceleration ``alpha = E @ accel + E' @ rates`` (``E'`` exact)."""
+    t1, t2, t3 = euler_product_order(reverse, a0 * scale, a1 * scale, a2 * scale)
+    u1, u2, u3 = euler_product_order(reverse, r0 * scale, r1 * scale, r2 * scale)
+    g1, g2, g3 = euler_product_order(reverse, d0 * scale, d1 * scale, d2 * scale)
+    c = euler_rate_columns(parity, proper, body, t1, t2, t3)
+    dc = euler_rate_column_derivatives(parity, proper, body, t1, t2, t3, u1, u2, u3)
+    p0 = c[0] * g1 + c[3] * g2 + c[6] * g3 + dc[0] * u1 + dc[3] * u2 + dc[6] * u3
+    p1 = c[1] * g1 + c[4] * g2 + c[7] * g3 + dc[1] * u1 + dc[4] * u2 + dc[7] * u3
+    p2 = c[2] * g1 + c[5] * g2 + c[8] * g3 + dc[2] * u1 + dc[5] * u2 + dc[8] * u3
+    return permuted_to_world_3(e1, e2, p0, p1, p2)
+
+
+@kernel(inputs=[(3,), (3,), (3,)], outputs=[(3,), ()], params=_PARAMS)
+def euler_accelerations_from_alpha(
+    e1, e2, parity, proper, reverse, body, scale, a0, a1, a2, r0, r1, r2, ax, ay, az
+):
+    """Euler second derivatives ``E^-1 (alpha - E' @ rates)`` and the lock distance."""
+    t1, t2, t3 = euler_product_order(reverse, a0 * scale, a1 * scale, a2 * scale)
+    u1, u2, u3 = euler_product_order(reverse, r0 * scale, r1 * scale, r2 * scale)
+    dc = euler_rate_column_derivatives(parity, proper, body, t1, t2, t3, u1, u2, u3)
+    r = euler_rate_inverse_rows(parity, proper, body, t1, t2, t3)
+    al = (ax, ay, az)
+    m = 3 - e1 - e2
+    p0 = al[e1] - (dc[0] * u1 + dc[3] * u2 + dc[6] * u3)
+    p1 = al[e2] - (dc[1] * u1 + dc[4] * u2 + dc[7] * u3)
+    p2 = al[m] - (dc[2] * u1 + dc[5] * u2 + dc[8] * u3)
+    inv = 1.0 / scale
+    g1 = inv * dot3(r[0], r[1], r[2], p0, p1, p2)
+    g2 = inv * dot3(r[3], r[4], r[5], p0, p1, p2)
+    g3 = inv * dot3(r[6], r[7], r[8], p0, p1, p2)
+    rev = reverse == 1
+    return (where(rev, g3, g1), g2, where(rev, g1, g3), lock_distance(r[9]))
