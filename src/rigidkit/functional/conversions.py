@@ -3,7 +3,22 @@
 Names read right to left, ``target_from_source``. Quaternions are Hamilton,
 scalar first ``(w, x, y, z)``; matrices are active and act on column vectors
 (``v_A = A_R_B @ v_B``). Every function is batched over leading axes, keeps the
-array namespace and dtype of its input, and validates what a user could get wrong.
+array namespace and dtype of its input, and validates what a user could get wrong,
+as the classes do: a quaternion is normalised first (any finite nonzero scale names
+a rotation, as in :meth:`rigidkit.Rotation.from_quat`), and a zero or non-finite
+one raises :class:`~rigidkit.ZeroNormError` or :class:`~rigidkit.NonFiniteError`
+naming its batch index.
+
+``quat_multiply``, ``quat_conjugate`` and ``quat_canonical`` are quaternion
+algebra, defined for every quaternion: they take it as it is (no normalisation),
+so the product of unit quaternions stays the bare kernel call.
+
+Unchecked variants: ``matrix_from_quat_unchecked``, ``rotvec_from_quat_unchecked``,
+``mrp_from_quat_unchecked``, ``axis_angle_from_quat_unchecked``,
+``quat_apply_unchecked`` and ``quat_angle_between_unchecked`` are the kernels
+themselves, for quaternions already known to be unit (the object layer's, unit by
+construction). They neither normalise nor check anything: a non-unit quaternion
+gives a wrong result and a NaN one NaN, never an error.
 
 >>> import numpy as np
 >>> q = quat_from_rotvec(np.array([0.0, 0.0, np.pi / 2]))
@@ -11,6 +26,10 @@ array namespace and dtype of its input, and validates what a user could get wron
 array([[ 0., -1.,  0.],
        [ 1.,  0.,  0.],
        [ 0.,  0.,  1.]])
+>>> matrix_from_quat([2.0, 0.0, 0.0, 0.0])       # normalised first: the identity
+array([[1., 0., 0.],
+       [0., 1., 0.],
+       [0., 0., 1.]])
 """
 
 from __future__ import annotations
@@ -19,9 +38,18 @@ import math
 
 import numpy as np
 
-from .._engine.namespace import is_float32, is_numpy, namespace_of
-from .._validate import as_array, batch_index, check_finite, finite_array, where_text
-from ..errors import NotARotationError, ZeroNormError
+from .._engine.namespace import is_numpy, namespace_of
+from .._validate import (
+    all_true,
+    as_array,
+    check_finite,
+    check_rotation,
+    default_atol,
+    finite_array,
+    raise_unless,
+    raise_where,
+)
+from ..errors import ZeroNormError
 from ..kernels import axis_angle as _aa
 from ..kernels import matrix as _mat
 from ..kernels import mrp as _mrp
@@ -46,17 +74,20 @@ __all__ = [
     "quat_wxyz_from_xyzw",
     "quat_xyzw_from_wxyz",
     "nearest_rotation_matrix",
+    "default_atol",
 ]
 
 quat_multiply = _q.quat_multiply
 quat_conjugate = _q.quat_conjugate
-quat_apply = _q.quat_apply
 quat_canonical = _q.quat_canonical
-quat_angle_between = _q.quat_angle_between
-matrix_from_quat = _mat.matrix_from_quat
-rotvec_from_quat = _rv.rotvec_from_quat
-mrp_from_quat = _mrp.mrp_from_quat
-axis_angle_from_quat = _aa.axis_angle_from_quat
+
+# The unchecked variants (module docs): the kernels, for quaternions known to be unit.
+matrix_from_quat_unchecked = _mat.matrix_from_quat
+rotvec_from_quat_unchecked = _rv.rotvec_from_quat
+mrp_from_quat_unchecked = _mrp.mrp_from_quat
+axis_angle_from_quat_unchecked = _aa.axis_angle_from_quat
+quat_apply_unchecked = _q.quat_apply
+quat_angle_between_unchecked = _q.quat_angle_between
 
 
 def quat_normalize(q, *, what="quaternion"):
@@ -80,11 +111,10 @@ def quat_normalize(q, *, what="quaternion"):
     # One test on the kernel's norm output catches zero, NaN and inf inputs alike
     # (NaN fails every comparison), so valid input costs no separate pass.
     ok = (norm > 0.0) & (norm < math.inf)
-    if not _all(ok):
+    if not all_true(ok):
         check_finite(q, (4,), what)
-        raise ZeroNormError(
-            f"{what} has zero norm {where_text(batch_index(~_np(ok)))}; "
-            "it names no rotation"
+        raise_unless(
+            ok, ZeroNormError, f"{what} has zero norm {{where}}; it names no rotation"
         )
     return unit
 
@@ -98,14 +128,64 @@ def _quiet():
     return np.errstate(invalid="ignore", divide="ignore", over="ignore")
 
 
-def _all(mask) -> bool:
-    if getattr(mask, "ndim", 0) == 0:
-        return bool(mask)
-    return bool(namespace_of(mask).all(mask))
+def matrix_from_quat(quat, *, out=None):
+    """Rotation matrices of quaternions, normalised first: (..., 4) -> (..., 3, 3).
+
+    ``R = I + 2 w hat(v) + 2 hat(v)^2`` for the unit ``(w, v) = q / |q|``.
+    ``out``: a NumPy buffer of shape (..., 3, 3) for the result.
+
+    See Also
+    --------
+    quat_from_matrix : the inverse; matrix_from_quat_unchecked for unit input.
+    """
+    return _mat.matrix_from_quat(quat_normalize(quat), out=out)
 
 
-def _np(a):
-    return np.asarray(a.detach().cpu().numpy() if hasattr(a, "detach") else a)
+def rotvec_from_quat(quat):
+    """Rotation vectors ``angle * axis``, angle in [0, pi], of quaternions (..., 4).
+
+    Normalised first; ``q`` and ``-q`` give the same vector. See Also:
+    :func:`quat_from_rotvec` (the inverse).
+    """
+    return _rv.rotvec_from_quat(quat_normalize(quat))
+
+
+def mrp_from_quat(quat):
+    """Modified Rodrigues parameters ``axis * tan(angle / 4)`` (norm <= 1), (..., 3).
+
+    Of quaternions (..., 4), normalised first; the shadow set is never returned.
+    See Also: :func:`quat_from_mrp` (the inverse).
+    """
+    return _mrp.mrp_from_quat(quat_normalize(quat))
+
+
+def axis_angle_from_quat(quat):
+    """``(axis, angle)``: unit axes (..., 3) and angles (...) in [0, pi] of quaternions.
+
+    Normalised first; the identity has axis ``+x`` and angle 0. See Also:
+    :func:`quat_from_axis_angle` (the inverse).
+    """
+    return _aa.axis_angle_from_quat(quat_normalize(quat))
+
+
+def quat_apply(quat, vectors, *, out=None):
+    """Rotate vectors (..., 3) by quaternions (..., 4), normalised first; shapes broadcast.
+
+    ``v -> q v q*`` for the unit ``q / |q|`` (active rotation, Hamilton).
+
+    >>> np.round(quat_apply([1.0, 0.0, 0.0, 1.0], [1.0, 0.0, 0.0]), 12) + 0.0
+    array([0., 1., 0.])
+    """
+    v = as_array(vectors, (3,), "vectors")
+    return _q.quat_apply(quat_normalize(quat), v, out=out)
+
+
+def quat_angle_between(quat1, quat2):
+    """Angle (radians, [0, pi]) of the rotation between quaternions, shape (...).
+
+    Both are normalised first; ``q`` and ``-q`` are the same rotation (angle 0).
+    """
+    return _q.quat_angle_between(quat_normalize(quat1), quat_normalize(quat2))
 
 
 def quat_wxyz_from_xyzw(q):
@@ -120,11 +200,6 @@ def quat_xyzw_from_wxyz(q):
     xp = namespace_of(q)
     q = np.asarray(q) if is_numpy(xp) else q
     return xp.concat([q[..., 1:], q[..., :1]], axis=-1)
-
-
-def default_atol(dtype) -> float:
-    """Tolerance of :func:`quat_from_matrix`: 1e-6 for float64, 1e-4 for float32."""
-    return 1e-4 if is_float32(dtype) else 1e-6
 
 
 def quat_from_matrix(matrix, *, atol=None, orthonormalize=False):
@@ -157,30 +232,8 @@ def quat_from_matrix(matrix, *, atol=None, orthonormalize=False):
     else:
         with _quiet():
             q, err = _mat.quat_from_matrix(m)
-    tol = default_atol(getattr(q, "dtype", None)) if atol is None else atol
-    # NaN fails every comparison, so non-finite input is caught here too.
-    ok = err <= tol
-    if not _all(ok):
-        check_finite(m, (3, 3), "rotation matrix")
-        idx = batch_index(~_np(ok))
-        raise NotARotationError(
-            f"matrix {where_text(idx)} is not a rotation: {_why(m, idx)} "
-            f"(tolerance {tol:g}; pass orthonormalize=True for the nearest rotation)"
-        )
+    check_rotation(m, err, atol)
     return q
-
-
-def _why(m, idx) -> str:
-    a = np.asarray(m.detach().cpu().numpy() if hasattr(m, "detach") else m)[idx]
-    a = a.astype(np.float64)
-    det = float(np.linalg.det(a))
-    dev = float(np.abs(a.T @ a - np.eye(3)).max())
-    if det < 0:
-        return f"det = {det:.6g} < 0 (a reflection)"
-    sv = np.linalg.svd(a, compute_uv=False)
-    if np.abs(sv - sv.mean()).max() < 1e-3 * max(sv.max(), 1e-300):
-        return f"it scales by {sv.mean():.9g} (|R^T R - I| = {dev:.3g})"
-    return f"|R^T R - I| = {dev:.3g}, singular values {np.round(sv, 6).tolist()}"
 
 
 def nearest_rotation_matrix(matrix):
@@ -216,8 +269,6 @@ def quat_from_axis_angle(axis, angle):
     t = as_array(angle, (), "angle")
     check_finite(a, (3,), "axis")
     check_finite(t, (), "angle")
-    xp = namespace_of(a)
-    zero = xp.all(a == 0, axis=-1)
-    if bool(xp.any(zero)):
-        raise ZeroNormError(f"axis is the zero vector {where_text(batch_index(zero))}")
+    zero = namespace_of(a).all(a == 0, axis=-1)
+    raise_where(zero, ZeroNormError, "axis is the zero vector {where}")
     return _aa.quat_from_axis_angle(a, t)

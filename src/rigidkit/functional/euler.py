@@ -50,7 +50,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .._engine.namespace import is_float32, namespace_of
-from .._validate import batch_index, finite_array, where_text
+from .._validate import batch_index, finite_array, to_numpy, where_text
 from ..errors import EulerSequenceError, GimbalLockWarning
 from ..kernels import euler as _k
 from . import conversions as _conv
@@ -344,7 +344,7 @@ def matrix_from_euler(seq, angles, *, degrees=False):
            [ 1.,  0.,  0.],
            [ 0.,  0.,  1.]])
     """
-    return _conv.matrix_from_quat(quat_from_euler(seq, angles, degrees=degrees))
+    return _conv.matrix_from_quat_unchecked(quat_from_euler(seq, angles, degrees=degrees))
 
 
 def euler_from_matrix(seq, matrix, *, degrees=False, atol=None):
@@ -364,12 +364,7 @@ def euler_from_matrix(seq, matrix, *, degrees=False, atol=None):
     >>> np.round(euler_from_matrix("XYZ", Rz, degrees=True), 12) + 0.0
     array([ 0.,  0., 90.])
     """
-    q = _conv.quat_from_matrix(matrix, atol=atol)
-    s = parse_sequence(seq)
-    scale = 180.0 / math.pi if degrees else 1.0
-    angles = _k.euler_from_quat(*s.params, scale, lock_tolerance(_dtype(q)), q)
-    _warn_if_locked(s, angles, scale)
-    return angles
+    return euler_from_quat(seq, _conv.quat_from_matrix(matrix, atol=atol), degrees=degrees)
 
 
 def _warn_if_locked(s: EulerSequence, angles, scale: float) -> None:
@@ -397,7 +392,7 @@ def _warn_if_locked(s: EulerSequence, angles, scale: float) -> None:
         near = xp.abs(mid - center) > half - tol
         if not bool(xp.any(near)):
             return
-    near = _host(near)
+    near = to_numpy(near)
     lock = "0 or pi" if s.proper else "+-pi/2"
     warnings.warn(
         f"gimbal lock in {s.text!r}: {int(near.sum())} of {max(near.size, 1)} middle "
@@ -408,10 +403,6 @@ def _warn_if_locked(s: EulerSequence, angles, scale: float) -> None:
         GimbalLockWarning,
         stacklevel=_user_stacklevel(),
     )
-
-
-def _host(a):
-    return a.detach().cpu().numpy() if hasattr(a, "detach") else np.asarray(a)
 
 
 _PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))

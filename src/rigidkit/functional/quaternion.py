@@ -19,9 +19,7 @@ array([-1.,  0.,  0.,  0.])
 
 from __future__ import annotations
 
-import numpy as np
-
-from .._validate import any_true, as_array, batch_index, check_finite, where_text
+from .._validate import as_array, as_float, check_finite, raise_where
 from ..errors import ZeroNormError
 from ..kernels import quaternion as _kq
 from ..kernels import quaternion_algebra as _ka
@@ -42,18 +40,12 @@ __all__ = [
 
 def _quat(q, what="quaternion"):
     """``q`` as a float array of shape (..., 4) of its own namespace."""
-    q = as_array(q, (4,), what)
-    if isinstance(q, np.ndarray) and q.dtype.kind != "f":
-        q = q.astype(np.float64)
-    return q
+    return as_float(as_array(q, (4,), what))
 
 
 def _reject_zero(result, largest, what):
     """``result``, unless ``largest`` (the largest |component|) is 0 somewhere."""
-    zero = largest == 0.0
-    if any_true(zero):
-        where = where_text(batch_index(zero))
-        raise ZeroNormError(f"{what} is the zero quaternion {where}")
+    raise_where(largest == 0.0, ZeroNormError, f"{what} is the zero quaternion {{where}}")
     return result
 
 
@@ -106,6 +98,7 @@ def exp(q):
     ``q2`` commute. For a pure ``q = (0, theta/2 u)`` it is the unit quaternion
     of the rotation by ``theta`` about ``u``.
 
+    >>> import numpy as np
     >>> np.round(exp([0.0, 0.0, 0.0, np.pi / 2]), 12) + 0.0   # e^(k pi/2) = k
     array([0., 0., 0., 1.])
 
@@ -131,6 +124,7 @@ def log(q):
     ZeroNormError
         For a zero quaternion (log 0 is undefined), naming its batch index.
 
+    >>> import numpy as np
     >>> np.round(log([-1.0, 0.0, 0.0, 0.0]), 12) + 0.0           # log(-1) = i pi
     array([0.        , 3.14159265, 0.        , 0.        ])
 

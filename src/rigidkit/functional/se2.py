@@ -23,30 +23,14 @@ True
 
 from __future__ import annotations
 
-import numpy as np
-
 from .._engine.namespace import namespace_of
-from .._validate import as_array, batch_index, finite_array, where_text
+from .._validate import as_array, check_bottom_row, check_rotation_2d, finite_array
 from ..errors import NotARigidTransformError
 from ..kernels import se2 as _k
-from .conversions import default_atol
-from .so2 import check_rotation_block
+from . import _lie
+from .so2 import complex_normalize
 
-__all__ = [
-    "hat",
-    "vee",
-    "exp",
-    "log",
-    "adjoint",
-    "ad",
-    "bracket",
-    "left_jacobian",
-    "right_jacobian",
-    "left_jacobian_inverse",
-    "right_jacobian_inverse",
-    "pose_from_matrix",
-    "matrix_from_pose",
-]
+__all__ = [*_lie.VOCABULARY, "pose_from_matrix", "matrix_from_pose"]
 
 
 def _twist(xi, what="se(2) twist"):
@@ -137,19 +121,14 @@ def left_jacobian(xi):
     return _k.left_jacobian(_twist(xi))
 
 
-def right_jacobian(xi):
-    """Right Jacobian, ``exp(ξ + δ) ≈ exp(ξ) exp(J_r(ξ) δ)``; ``J_r(ξ) = J_l(-ξ)``."""
-    return _k.left_jacobian(-_twist(xi))
-
-
 def left_jacobian_inverse(xi):
     """Inverse of :func:`left_jacobian` (closed form; defined for |ω| < 2 pi)."""
     return _k.left_jacobian_inverse(_twist(xi))
 
 
-def right_jacobian_inverse(xi):
-    """Inverse of :func:`right_jacobian`, ``J_l^-1(-ξ)`` (defined for |ω| < 2 pi)."""
-    return _k.left_jacobian_inverse(-_twist(xi))
+right_jacobian, right_jacobian_inverse = _lie.right_jacobians(
+    __name__, "SE(2)", 3, "se(2) twist", _k.left_jacobian, _k.left_jacobian_inverse
+)
 
 
 def pose_from_matrix(matrix, *, atol=None, orthonormalize=False):
@@ -177,27 +156,28 @@ def pose_from_matrix(matrix, *, atol=None, orthonormalize=False):
         Naming the first offending batch index.
     """
     m = finite_array(matrix, (3, 3), "SE(2) matrix")
-    pose, norm, err, bottom = _k.pose_from_matrix(m)
-    tol = default_atol(getattr(err, "dtype", "float64")) if atol is None else atol
-    bad = bottom > tol
-    if bool(namespace_of(bad).any(bad)):
-        idx = batch_index(bad)
-        row = [float(v) for v in _row(m, idx)]
-        raise NotARigidTransformError(
-            f"SE(2) matrix {where_text(idx)} has bottom row {row}, "
-            f"not [0, 0, 1] (tolerance {tol:g})"
-        )
-    check_rotation_block(
-        m, norm, err, atol=tol, orthonormalize=orthonormalize, what="SE(2) matrix"
+    check_bottom_row(
+        m, atol, "a rigid transform", NotARigidTransformError, what="SE(2) matrix"
+    )
+    pose, norm, err, _ = _k.pose_from_matrix(m)
+    check_rotation_2d(
+        m[..., :2, :2],
+        norm,
+        err,
+        atol=atol,
+        orthonormalize=orthonormalize,
+        what="SE(2) matrix",
     )
     return pose
 
 
-def matrix_from_pose(pose):
-    """Homogeneous matrices ``[[c, -s, tx], [s, c, ty], [0, 0, 1]]`` of poses (..., 4)."""
-    return _k.matrix_from_pose(as_array(pose, (4,), "SE(2) pose"))
+def matrix_from_pose(pose, *, out=None):
+    """Homogeneous matrices ``[[c, -s, tx], [s, c, ty], [0, 0, 1]]`` of poses (..., 4).
 
-
-def _row(m, idx):
-    a = np.asarray(m.detach().cpu().numpy() if hasattr(m, "detach") else m)
-    return a[idx][2]
+    Poses are ``(cos θ, sin θ, tx, ty)``; the pair ``(cos θ, sin θ)`` is normalised
+    first (any finite nonzero scale), as in :class:`rigidkit.Transform2D`.
+    """
+    p = as_array(pose, (4,), "SE(2) pose")
+    cs = complex_normalize(p[..., :2], what="SE(2) pose (cos, sin)")
+    t = finite_array(p[..., 2:], (2,), "SE(2) pose translation")
+    return _k.matrix_from_pose(namespace_of(cs).concat([cs, t], axis=-1), out=out)

@@ -29,40 +29,19 @@ True
 
 from __future__ import annotations
 
-import numpy as np
-
-from .._engine.namespace import namespace_of
-from .._validate import (
-    _to_numpy,
-    as_array,
-    batch_index,
-    finite_array,
-    where_text,
-)
+from .._validate import as_array, check_bottom_row, finite_array
 from ..errors import NotARigidTransformError, NotARotationError
 from ..kernels import se3 as _k
+from . import _lie
 from . import conversions as _conv
 
 __all__ = [
-    "hat",
-    "vee",
-    "exp",
-    "log",
-    "adjoint",
-    "ad",
-    "bracket",
-    "left_jacobian",
-    "right_jacobian",
-    "left_jacobian_inverse",
-    "right_jacobian_inverse",
+    *_lie.VOCABULARY,
     "pose_from_matrix",
     "matrix_from_pose",
     "pose_from_twist",
     "twist_from_pose",
 ]
-
-matrix_from_pose = _k.matrix_from_pose
-twist_from_pose = _k.twist_from_pose
 
 
 def _twist(xi, what="twist"):
@@ -183,52 +162,29 @@ def pose_from_matrix(M, *, atol=None, orthonormalize=False):
     try:
         q = _conv.quat_from_matrix(M[..., :3, :3], atol=atol, orthonormalize=orthonormalize)
     except NotARotationError as err:
-        raise NotARigidTransformError(f"rotation block of the homogeneous {err}") from None
+        raise NotARigidTransformError(
+            f"rotation block of the homogeneous {err}", index=err.index
+        ) from None
     return _k.pose_from_quat_translation(q, M[..., :3, 3])
 
 
-def check_bottom_row(M, atol, kind, error):
-    """Raise ``error`` where the bottom row of ``M`` (..., 4, 4) is not ``[0, 0, 0, 1]``.
-
-    The one bottom-row check of every 4x4 homogeneous kind (SE(3), Sim(3), affine):
-    ``kind`` names the kind in the message (``"a rigid transform"``), ``atol``
-    defaults to :func:`rigidkit.conversions.default_atol` of the dtype.
-    """
-    tol = _conv.default_atol(M.dtype) if atol is None else atol
-    if isinstance(M, np.ndarray) and M.ndim == 2:
-        # One matrix: four float comparisons cost less than one ufunc call.
-        a, b, c, d = M[3].tolist()
-        if max(abs(a), abs(b), abs(c), abs(d - 1.0)) <= tol:
-            return
-    xp = namespace_of(M)
-    bottom = M[..., 3, :]
-    bad = xp.any(xp.abs(bottom[..., :3]) > tol, axis=-1) | (
-        xp.abs(bottom[..., 3] - 1.0) > tol
-    )
-    if bool(xp.any(bad)):
-        idx = batch_index(bad)
-        row = _to_numpy(bottom)[idx].tolist()
-        raise error(
-            f"homogeneous matrix {where_text(idx)} is not {kind}: bottom row {row} is not "
-            f"[0, 0, 0, 1] (tolerance {tol:g})"
-        )
-
-
-def adjoint(M):
+def adjoint(M, *, atol=None):
     """Adjoint ``[[R, hat(t) R], [0, R]]`` (6x6) of homogeneous ``[[R, t], [0, 1]]``.
 
     For twists ``(v, w)``: ``M exp(V) M^-1 = exp(Ad V)`` and
-    ``M hat(V) M^-1 = hat(Ad V)``. The blocks are used as given (no validation).
+    ``M hat(V) M^-1 = hat(Ad V)``. ``M`` is validated like
+    :func:`pose_from_matrix` (with tolerance ``atol``).
 
     Parameters
     ----------
     M : array_like, shape (..., 4, 4)
+    atol : float, optional
 
     Returns
     -------
     ndarray, shape (..., 6, 6)
     """
-    return _k.adjoint_from_matrix(as_array(M, (4, 4), "homogeneous matrix"))
+    return _k.adjoint_from_pose(pose_from_matrix(M, atol=atol))
 
 
 def ad(xi):
@@ -287,24 +243,6 @@ def left_jacobian(xi):
     return _k.left_jacobian(_twist(xi))
 
 
-def right_jacobian(xi):
-    """Right Jacobian of SE(3): ``exp(V + d) ~ exp(V) exp(J_r(V) d)``; ``J_r(V) = J_l(-V)``.
-
-    Parameters
-    ----------
-    xi : array_like, shape (..., 6)
-
-    Returns
-    -------
-    ndarray, shape (..., 6, 6)
-
-    See Also
-    --------
-    left_jacobian, right_jacobian_inverse
-    """
-    return _k.left_jacobian(-_twist(xi))
-
-
 def left_jacobian_inverse(xi):
     """Inverse of :func:`left_jacobian`: ``log(exp(d) exp(V)) ~ V + J_l(V)^-1 d``.
 
@@ -322,15 +260,52 @@ def left_jacobian_inverse(xi):
     return _k.left_jacobian_inverse(_twist(xi))
 
 
-def right_jacobian_inverse(xi):
-    """Inverse of :func:`right_jacobian`: ``log(exp(V) exp(d)) ~ V + J_r(V)^-1 d``.
+right_jacobian, right_jacobian_inverse = _lie.right_jacobians(
+    __name__, "SE(3)", 6, "twist", _k.left_jacobian, _k.left_jacobian_inverse
+)
+
+
+def _pose(pose):
+    """A validated pose: the quaternion normalised, the translation finite."""
+    p = as_array(pose, (7,), "pose")
+    q = _conv.quat_normalize(p[..., :4], what="pose quaternion")
+    t = finite_array(p[..., 4:], (3,), "pose translation")
+    return _k.pose_from_quat_translation(q, t)
+
+
+def matrix_from_pose(pose, *, out=None):
+    """Homogeneous matrices ``[[R, t], [0, 1]]`` of poses ``(w, x, y, z, tx, ty, tz)``.
+
+    The quaternion is normalised first (any finite nonzero scale), as in
+    :class:`rigidkit.Transform`.
 
     Parameters
     ----------
-    xi : array_like, shape (..., 6)
+    pose : array_like, shape (..., 7)
+    out : ndarray, shape (..., 4, 4), optional
 
     Returns
     -------
-    ndarray, shape (..., 6, 6)
+    ndarray, shape (..., 4, 4)
+
+    See Also
+    --------
+    pose_from_matrix
     """
-    return _k.left_jacobian_inverse(-_twist(xi))
+    return _k.matrix_from_pose(_pose(pose), out=out)
+
+
+def twist_from_pose(pose):
+    """Twists ``(v, w)``, ``|w|`` in [0, pi], of poses ``(w, x, y, z, tx, ty, tz)``.
+
+    The quaternion is normalised first; the inverse of :func:`pose_from_twist`.
+
+    Parameters
+    ----------
+    pose : array_like, shape (..., 7)
+
+    Returns
+    -------
+    ndarray, shape (..., 6)
+    """
+    return _k.twist_from_pose(_pose(pose))

@@ -16,17 +16,25 @@ True
 
 from __future__ import annotations
 
-import numpy as np
-
 from .._engine.namespace import namespace_of
-from .._validate import _to_numpy, as_array, as_float, batch_index, check_finite, where_text
+from .._validate import (
+    as_array,
+    as_float,
+    check_bottom_row,
+    check_finite,
+    default_atol,
+    raise_unless,
+    raise_where,
+    where_text,
+    why_not_rotation,
+)
 from ..errors import NotASimilarityError
 from ..kernels import matrix as _kmat
 from ..kernels import sim3 as _k
-from . import conversions as _conv
-from .se3 import check_bottom_row
+from . import _lie
 
-__all__ = ["hat", "vee", "exp", "log", "adjoint", "ad", "bracket", "pose_from_matrix"]
+# Sim(3) has no Jacobians here (yet): the vocabulary up to ``bracket``.
+__all__ = [*_lie.VOCABULARY[:7], "pose_from_matrix"]
 
 
 def _twist(xi, what="sim(3) twist"):
@@ -105,28 +113,21 @@ def pose_from_matrix(matrix, *, atol=None):
     xp = namespace_of(M)
     A = M[..., :3, :3]
     s = xp.sqrt(xp.sum(A * A, axis=(-2, -1)) / 3.0)
-    zero = s == 0.0
-    if bool(xp.any(zero)):
-        raise NotASimilarityError(
-            f"3x3 block of the homogeneous matrix {where_text(batch_index(zero))} is "
-            "zero; a similarity needs a positive scale"
-        )
-    q, err = _kmat.quat_from_matrix(A / s[..., None, None])
-    tol = _conv.default_atol(q.dtype) if atol is None else atol
-    bad = err > tol
-    if bool(xp.any(bad)):
-        idx = batch_index(bad)
-        raise NotASimilarityError(
+    raise_where(
+        s == 0.0,
+        NotASimilarityError,
+        "3x3 block of the homogeneous matrix {where} is zero; a similarity needs a "
+        "positive scale",
+    )
+    R = A / s[..., None, None]
+    q, err = _kmat.quat_from_matrix(R)
+    tol = default_atol(M.dtype) if atol is None else atol
+
+    def message(idx):
+        return (
             f"3x3 block of the homogeneous matrix {where_text(idx)} is not a positive "
-            f"scalar times a rotation: {_why(A, idx)} (tolerance {tol:g})"
+            f"scalar times a rotation: {why_not_rotation(R, idx)} (tolerance {tol:g})"
         )
+
+    raise_unless(err <= tol, NotASimilarityError, message)
     return xp.concat([q, M[..., :3, 3], s[..., None]], axis=-1)
-
-
-def _why(A, idx) -> str:
-    a = np.asarray(_to_numpy(A)[idx], dtype=np.float64)
-    det = float(np.linalg.det(a))
-    sv = np.linalg.svd(a, compute_uv=False)
-    if det < 0:
-        return f"det = {det:.6g} < 0 (a reflection)"
-    return f"singular values {np.round(sv, 6).tolist()} are not all equal"

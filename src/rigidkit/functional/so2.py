@@ -21,29 +21,12 @@ array([1.57079633])
 
 from __future__ import annotations
 
-import numpy as np
-
-from .._engine.namespace import namespace_of
-from .._validate import as_array, batch_index, finite_array, where_text
-from ..errors import NotARotationError, ZeroNormError
+from .._validate import as_array, check_rotation_2d, finite_array, raise_where
+from ..errors import ZeroNormError
 from ..kernels import so2 as _k
-from .conversions import default_atol
+from . import _lie
 
-__all__ = [
-    "hat",
-    "vee",
-    "exp",
-    "log",
-    "adjoint",
-    "ad",
-    "bracket",
-    "left_jacobian",
-    "right_jacobian",
-    "left_jacobian_inverse",
-    "right_jacobian_inverse",
-    "complex_from_matrix",
-    "complex_normalize",
-]
+__all__ = [*_lie.VOCABULARY, "complex_from_matrix", "complex_normalize"]
 
 
 def _tangent(w, what="so(2) vector"):
@@ -111,19 +94,14 @@ def left_jacobian(w):
     return _k.jacobian(_tangent(w))
 
 
-def right_jacobian(w):
-    """Right Jacobian ``[[1]]``: ``exp(θ + δ) = exp(θ) exp(δ)`` exactly."""
-    return _k.jacobian(_tangent(w))
-
-
 def left_jacobian_inverse(w):
-    """Inverse of :func:`left_jacobian`: ``[[1]]``."""
+    """Inverse of :func:`left_jacobian`: ``[[1]]``, shape (..., 1, 1)."""
     return _k.jacobian(_tangent(w))
 
 
-def right_jacobian_inverse(w):
-    """Inverse of :func:`right_jacobian`: ``[[1]]``."""
-    return _k.jacobian(_tangent(w))
+right_jacobian, right_jacobian_inverse = _lie.right_jacobians(
+    __name__, "SO(2)", 1, "so(2) vector", _k.jacobian, _k.jacobian
+)
 
 
 def complex_normalize(z, *, what="complex number"):
@@ -136,11 +114,9 @@ def complex_normalize(z, *, what="complex number"):
     """
     z = finite_array(z, (2,), what)
     unit, norm = _k.complex_normalize(z)
-    zero = norm == 0.0
-    if bool(namespace_of(norm).any(zero)):
-        raise ZeroNormError(
-            f"{what} is zero {where_text(batch_index(zero))}; it names no rotation"
-        )
+    raise_where(
+        norm == 0.0, ZeroNormError, f"{what} is zero {{where}}; it names no rotation"
+    )
     return unit
 
 
@@ -171,41 +147,5 @@ def complex_from_matrix(matrix, *, atol=None, orthonormalize=False):
     """
     m = finite_array(matrix, (2, 2), "rotation matrix")
     z, norm, err = _k.complex_from_matrix(m)
-    check_rotation_block(m, norm, err, atol=atol, orthonormalize=orthonormalize)
+    check_rotation_2d(m, norm, err, atol=atol, orthonormalize=orthonormalize)
     return z
-
-
-def check_rotation_block(m, norm, err, *, atol, orthonormalize, what="matrix"):
-    """Raise :class:`NotARotationError` for a 2x2 block (``m[..., :2, :2]``) that
-    is not a rotation (``err > atol``), or, with ``orthonormalize``, that has no
-    unique nearest rotation (``norm == 0``)."""
-    xp = namespace_of(err)
-    if orthonormalize:
-        bad = norm == 0.0
-        if bool(xp.any(bad)):
-            raise NotARotationError(
-                f"{what} {where_text(batch_index(bad))} has no unique nearest rotation "
-                "(m00 + m11 = m10 - m01 = 0, e.g. a reflection)"
-            )
-        return
-    tol = default_atol(getattr(err, "dtype", "float64")) if atol is None else atol
-    bad = err > tol
-    if bool(xp.any(bad)):
-        idx = batch_index(bad)
-        raise NotARotationError(
-            f"{what} {where_text(idx)} is not a rotation: {_why(m, idx)} "
-            f"(tolerance {tol:g}; pass orthonormalize=True for the nearest rotation)"
-        )
-
-
-def _why(m, idx) -> str:
-    a = np.asarray(m.detach().cpu().numpy() if hasattr(m, "detach") else m)[idx]
-    a = a[:2, :2].astype(np.float64)
-    det = float(np.linalg.det(a))
-    dev = float(np.abs(a.T @ a - np.eye(2)).max())
-    if det < 0:
-        return f"det = {det:.6g} < 0 (a reflection)"
-    sv = np.linalg.svd(a, compute_uv=False)
-    if np.abs(sv - sv.mean()).max() < 1e-3 * max(sv.max(), 1e-300):
-        return f"it scales by {sv.mean():.6g} (|R^T R - I| = {dev:.3g})"
-    return f"|R^T R - I| = {dev:.3g}, singular values {np.round(sv, 6).tolist()}"

@@ -15,9 +15,19 @@ from __future__ import annotations
 from .._validate import as_array, finite_array
 from ..kernels import rotvec as _rv
 from ..kernels import so3 as _k
+from ..kernels import so3_jacobians as _jac
+from . import _lie
 from . import conversions as _conv
 
-__all__ = ["hat", "vee", "exp", "log"]
+__all__ = list(_lie.VOCABULARY)
+
+# Jacobian conventions, for rotation vectors w and small d:
+#   left:  exp(w + d) ~ exp(J_l(w) d) exp(w)     right: exp(w + d) ~ exp(w) exp(J_r(w) d)
+#   J_r(w) = J_l(-w) = J_l(w)^T.
+
+
+def _rotvec(w):
+    return finite_array(w, (3,), "rotation vector")
 
 
 def hat(w):
@@ -42,8 +52,7 @@ def exp(w):
     -------
     ndarray, shape (..., 3, 3)
     """
-    w = finite_array(w, (3,), "rotation vector")
-    return _rv.matrix_from_rotvec(w)
+    return _rv.matrix_from_rotvec(_rotvec(w))
 
 
 def log(R, *, atol=None):
@@ -58,40 +67,23 @@ def log(R, *, atol=None):
     return _rv.rotvec_from_quat(_conv.quat_from_matrix(R, atol=atol))
 
 
-# -- Lie calculus (appended with the SE(3) work) ---------------------------------------
-# Jacobian conventions, for rotation vectors w and small d:
-#   left:  exp(w + d) ~ exp(J_l(w) d) exp(w)     right: exp(w + d) ~ exp(w) exp(J_r(w) d)
-#   J_r(w) = J_l(-w) = J_l(w)^T.
-
-from ..kernels import so3_jacobians as _jac  # noqa: E402
-
-__all__ += [
-    "adjoint",
-    "ad",
-    "bracket",
-    "left_jacobian",
-    "right_jacobian",
-    "left_jacobian_inverse",
-    "right_jacobian_inverse",
-]
-
-
-def _rotvec(w):
-    return finite_array(w, (3,), "rotation vector")
-
-
-def adjoint(R):
+def adjoint(R, *, atol=None):
     """Adjoint of SO(3), the rotation matrix itself: ``R hat(w) R^T = hat(R w)``.
+
+    ``R`` is validated (see :func:`rigidkit.conversions.quat_from_matrix`) and the
+    result is a new array, the rotation matrix rebuilt from its quaternion.
 
     Parameters
     ----------
     R : array_like, shape (..., 3, 3)
+    atol : float, optional
+        Tolerance of the SO(3) check.
 
     Returns
     -------
     ndarray, shape (..., 3, 3)
     """
-    return as_array(R, (3, 3), "rotation matrix")
+    return _conv.matrix_from_quat_unchecked(_conv.quat_from_matrix(R, atol=atol))
 
 
 def ad(w):
@@ -155,25 +147,6 @@ def left_jacobian(w):
     return _jac.left_jacobian(_rotvec(w))
 
 
-def right_jacobian(w):
-    """Right Jacobian of SO(3): ``exp(w + d) ~ exp(w) exp(J_r(w) d)``; ``J_r(w) = J_l(-w)``.
-
-    Parameters
-    ----------
-    w : array_like, shape (..., 3)
-        Rotation vectors, radians.
-
-    Returns
-    -------
-    ndarray, shape (..., 3, 3)
-
-    See Also
-    --------
-    left_jacobian, right_jacobian_inverse
-    """
-    return _jac.left_jacobian(-_rotvec(w))
-
-
 def left_jacobian_inverse(w):
     """Inverse of :func:`left_jacobian`: ``log(exp(d) exp(w)) ~ w + J_l(w)^-1 d``.
 
@@ -191,15 +164,6 @@ def left_jacobian_inverse(w):
     return _jac.left_jacobian_inverse(_rotvec(w))
 
 
-def right_jacobian_inverse(w):
-    """Inverse of :func:`right_jacobian`: ``log(exp(w) exp(d)) ~ w + J_r(w)^-1 d``.
-
-    Parameters
-    ----------
-    w : array_like, shape (..., 3)
-
-    Returns
-    -------
-    ndarray, shape (..., 3, 3)
-    """
-    return _jac.left_jacobian_inverse(-_rotvec(w))
+right_jacobian, right_jacobian_inverse = _lie.right_jacobians(
+    __name__, "SO(3)", 3, "rotation vector", _jac.left_jacobian, _jac.left_jacobian_inverse
+)

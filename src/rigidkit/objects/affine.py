@@ -3,7 +3,7 @@
 The homogeneous matrix is ``[[A, t], [0, 1]]`` with ``A`` any invertible 3x3 matrix
 (rotations, scalings, shears, reflections). It sits between
 :class:`~rigidkit.Similarity` and :class:`~rigidkit.Projective` on the ladder of
-kinds (see :mod:`rigidkit.objects.projective`): composing with a lower kind gives an
+kinds (see :mod:`rigidkit.objects.ladder`): composing with a lower kind gives an
 ``Affine``, with a ``Projective`` a ``Projective``.
 """
 
@@ -12,24 +12,26 @@ from __future__ import annotations
 import numpy as np
 
 from .._engine.namespace import device_of, namespace_of
-from .._validate import _to_numpy, as_array, as_float, check_finite
+from .._validate import (
+    as_array,
+    as_float,
+    check_bottom_row,
+    check_finite,
+    check_invertible,
+    singular_rtol,
+    to_numpy,
+)
 from ..errors import NotAffineError
-from ..functional.se3 import check_bottom_row
 from ..kernels import homogeneous as _k
 from ._batch import BatchedArray, batch_shape
-from .projective import (
-    Projective,
-    _include_check,
-    _LadderMember,
-    check_invertible,
-    homogeneous_matrix,
-    singular_rtol,
-)
+from .group import Group
+from .ladder import homogeneous_matrix
+from .projective import Projective
 
 __all__ = ["Affine", "NotAffineError"]
 
 
-class Affine(BatchedArray, _LadderMember):
+class Affine(BatchedArray, Group, family="space", rank=3):
     """A batch of invertible affine transforms ``p -> A p + t``.
 
     Stored as one array of shape (..., 3, 4), ``[A | t]``. ``X1 @ X2`` applies ``X2``
@@ -45,7 +47,7 @@ class Affine(BatchedArray, _LadderMember):
         ``t`` (zero when omitted). Batch shapes broadcast.
     rtol : float, optional
         Default 1e-12 (float64) or 1e-5 (float32), see
-        :func:`rigidkit.objects.projective.singular_rtol`.
+        :func:`rigidkit._validate.singular_rtol`.
 
     Examples
     --------
@@ -59,6 +61,7 @@ class Affine(BatchedArray, _LadderMember):
 
     __slots__ = ("_data",)
     _trail = (3, 4)
+    _identity = np.eye(3, 4)  # [I | 0]
 
     def __init__(self, matrix=None, translation=None, *, rtol=None):
         A = (
@@ -122,19 +125,11 @@ class Affine(BatchedArray, _LadderMember):
     def from_similarity(cls, similarity):
         """The inclusion: a :class:`~rigidkit.Similarity` (or a ``Transform`` or
         ``Rotation``) as the affine map ``[[s R, t], [0, 1]]``."""
-        _include_check(cls, similarity, "Affine.from_similarity")
-        return cls._include(similarity)
+        return cls.include(similarity)
 
     @classmethod
     def _include(cls, x):
-        if type(x) is cls:
-            return x
         return cls._wrap(homogeneous_matrix(x)[..., :3, :])
-
-    @classmethod
-    def identity(cls, shape=(), *, dtype=None):
-        """Identity transforms of batch ``shape``."""
-        return cls._wrap(cls._filled(np.eye(3, 4), shape, dtype))
 
     @classmethod
     def random(cls, shape=(), rng=None, *, dtype=None):
@@ -172,10 +167,11 @@ class Affine(BatchedArray, _LadderMember):
 
     def as_projective(self):
         """The same transforms as :class:`~rigidkit.Projective`."""
-        return Projective._include(self)
+        return Projective.include(self)
 
     # -- operations --------------------------------------------------------------------
-    def _compose(self, other):
+    def compose(self, other):
+        """``self @ other`` (``other`` applied first) for another ``Affine``."""
         return Affine._wrap(_k.affine_compose(self._data, other._data))
 
     def apply(self, points):
@@ -195,14 +191,14 @@ class Affine(BatchedArray, _LadderMember):
 
     def approx_equal(self, other, *, atol=1e-12):
         """Elementwise ``max |[A1 | t1] - [A2 | t2]| <= atol``, shape (...)."""
-        other = Affine._include(other)
+        other = Affine.include(other)
         xp = namespace_of(self._data, other._data)
         close = xp.abs(self._data - other._data) <= atol
         return xp.all(xp.reshape(close, self.shape + (12,)), axis=-1)
 
     # -- container protocol (shape, len, [], reshape, ...): BatchedArray ------------------
     def _repr_single(self):
-        d = _to_numpy(self._data).tolist()
+        d = to_numpy(self._data).tolist()
         A = [row[:3] for row in d]
         t = [row[3] for row in d]
         return f"Affine(matrix={A!r}, translation={t!r})"

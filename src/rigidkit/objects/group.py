@@ -1,9 +1,10 @@
-"""The one interface every matrix Lie group of rigidkit implements.
+"""The interfaces every transform kind of rigidkit implements.
 
-Each group class (``Rotation`` = SO(3), ``Transform`` = SE(3), ``Rotation2D`` =
-SO(2), ``Transform2D`` = SE(2), ``Similarity`` = Sim(3)) holds one array and
-implements these operations; ``tests/test_group_axioms.py`` checks the axioms once
-for all of them.
+:class:`Group` is the base of every kind of transform (``Rotation``, ``Transform``,
+``Rotation2D``, ``Transform2D``, ``Similarity``, ``Affine``, ``Projective``): it
+defines ``@``, once. :class:`LieGroup` adds the Lie calculus of the matrix Lie
+groups (all of them but ``Affine`` and ``Projective``, which have no ``exp`` here);
+``tests/test_group_axioms.py`` checks the axioms once for all of them.
 
 ======================  =====================================================
 ``exp(tau)``            group element ``expm(hat(tau))`` (classmethod)
@@ -26,9 +27,99 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 
+from . import ladder
 
-class LieGroup(ABC):
+__all__ = ["Group", "LieGroup"]
+
+
+class Group(ABC):
+    """A batch of transforms: ``a @ b`` composes them, ``a @ p`` acts on points.
+
+    ``@``, :meth:`include` and :meth:`identity` are defined here for every kind (a
+    :class:`~rigidkit.objects._batch.BatchedArray` too). A subclass places itself
+    on the ladder of kinds (:mod:`rigidkit.objects.ladder`) with class keywords,
+    ``class Transform(BatchedArray, LieGroup, family="space", rank=1)``, stores its
+    identity element in ``_identity``, and implements ``compose`` (with another
+    element of its own kind), ``apply`` (to points), ``inv`` and, when a lower kind
+    exists, the class method ``_include`` (an element of a lower kind of its
+    family, as this kind). Then
+
+    - ``a @ b`` of one kind is ``a.compose(b)``;
+    - ``a @ b`` of two kinds of one family is composed in the more general kind
+      (``Rotation @ Transform`` is a ``Transform``, see :func:`ladder.compose`);
+    - ``a @ p`` for anything else is ``a.apply(p)``;
+    - ``array @ a`` is refused with a :class:`TypeError`.
+    """
+
+    __slots__ = ()
+    # NumPy's binary operators defer to ours, so ``ndarray @ X`` reaches
+    # ``__rmatmul__`` (and fails clearly) instead of broadcasting over X.
+    __array_ufunc__ = None
+
+    def __init_subclass__(cls, *, family=None, rank=None, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if family is not None:
+            ladder.register(cls, family, rank)
+
+    def __matmul__(self, other):
+        if type(other) is type(self):  # the common case, without looking up kinds
+            return self.compose(other)
+        if isinstance(other, Group):
+            return ladder.compose(self, other)
+        return self.apply(other)
+
+    def __rmatmul__(self, other):
+        name = type(self).__name__
+        raise TypeError(
+            f"array @ {name} is not defined; apply it to points with X @ p or X.apply(p)"
+        )
+
+    @classmethod
+    def include(cls, x):
+        """``x`` as an element of this kind: ``x`` itself, or of a kind included in it.
+
+        The inclusions of the ladder (:mod:`rigidkit.objects.ladder`): a rotation is
+        the rigid transform with zero translation, a rigid transform the similarity
+        of scale 1, ... Raises :class:`TypeError` for anything else (a more general
+        kind, another family, an array).
+
+        >>> import rigidkit as rk
+        >>> rk.Transform.include(rk.Rotation.identity())
+        Transform(rotation=Rotation.from_quat([1, 0, 0, 0]), translation=[0, 0, 0])
+        """
+        if type(x) is cls:
+            return x
+        ladder.check_included(cls, x, f"{cls.__name__}.include")
+        return cls._include(x)
+
+    @classmethod
+    def _include(cls, x):
+        """``x``, of a kind strictly below ``cls`` on its ladder, as ``cls`` (the hook
+        of :meth:`include`; a kind with nothing below it keeps this default)."""
+        raise TypeError(f"nothing is included in {cls.__name__}")
+
+    @classmethod
+    def identity(cls, shape=(), *, dtype=None):
+        """Identity elements of batch ``shape`` (``()`` for one), float64 by default.
+
+        Each kind stores its identity element as the class attribute ``_identity``.
+        """
+        return cls._wrap(cls._filled(cls._identity, shape, dtype))
+
+    @abstractmethod
+    def compose(self, other): ...
+
+    @abstractmethod
+    def apply(self, points): ...
+
+    @abstractmethod
+    def inv(self): ...
+
+
+class LieGroup(Group):
     """Abstract matrix Lie group, batched over leading axes (see module docs)."""
+
+    __slots__ = ()
 
     dof: int
     matrix_size: int
@@ -42,20 +133,10 @@ class LieGroup(ABC):
     def log(self): ...
 
     @abstractmethod
-    def inv(self): ...
-
-    @abstractmethod
-    def __matmul__(self, other): ...
-
-    @abstractmethod
     def adjoint(self): ...
 
     @abstractmethod
     def as_matrix(self): ...
-
-    @classmethod
-    @abstractmethod
-    def identity(cls, shape=()): ...
 
     @classmethod
     @abstractmethod

@@ -1,182 +1,41 @@
-"""``Projective``: invertible projective transforms of 3D space, and the ladder of kinds.
+"""``Projective``: invertible projective transforms of 3D space.
 
 A projective transform is an invertible 4x4 matrix ``H`` acting on homogeneous
 points: ``p -> (x, y, z) / w`` with ``(x, y, z, w) = H [p; 1]``. ``H`` and ``c H``
-(``c != 0``) are the same transform.
-
-The kinds of transform form a ladder, each included in the next::
-
-    Rotation  ⊂  Transform  ⊂  Similarity  ⊂  Affine  ⊂  Projective
-     SO(3)        SE(3)         Sim(3)       (A, t)     PGL(4)
-
-``a @ b`` of two kinds on the ladder is computed in the more general of the two
-(``Transform @ Affine`` is an ``Affine``, ``Similarity @ Projective`` a
-``Projective``). That rule lives here, once: :func:`compose` ranks both operands,
-includes each into the higher kind (``kind._include``) and composes there.
+(``c != 0``) are the same transform. It is the most general kind on the ladder of
+:mod:`rigidkit.objects.ladder`: every other kind of the space composes with it into
+a ``Projective``.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .._engine.namespace import device_of, is_float32, namespace_of
+from .._engine.namespace import device_of, namespace_of
 from .._validate import (
-    _to_numpy,
     any_true,
     as_array,
     as_float,
-    batch_index,
     check_finite,
-    where_text,
+    check_invertible,
+    infinity_rtol,
+    raise_where,
+    singular_rtol,
+    to_numpy,
 )
 from ..errors import PointAtInfinityError, SingularMatrixError
 from ..kernels import homogeneous as _k
 from ._batch import BatchedArray, batch_shape
+from .group import Group
+from .ladder import homogeneous_matrix
 
-__all__ = [
-    "Projective",
-    "SingularMatrixError",
-    "PointAtInfinityError",
-    "compose",
-]
-
-
-# -- the ladder ----------------------------------------------------------------------
-
-
-_LADDER: tuple = ()
-
-
-def _ladder() -> tuple:
-    """The kinds, from the least to the most general (imported late: no cycles)."""
-    global _LADDER
-    if not _LADDER:
-        from .affine import Affine
-        from .rotation import Rotation
-        from .similarity import Similarity
-        from .transform import Transform
-
-        _LADDER = (Rotation, Transform, Similarity, Affine, Projective)
-    return _LADDER
-
-
-def _rank(x) -> int:
-    """Position of ``x``'s kind on the ladder, or -1 when it is not a transform."""
-    for r, kind in enumerate(_ladder()):
-        if type(x) is kind:
-            return r
-    return -1
-
-
-def compose(a, b):
-    """``a @ b`` (``b`` applied first) in the more general kind of the two.
-
-    >>> import rigidkit as rk
-    >>> S = rk.Similarity(scale=2.0)
-    >>> T = rk.Transform(translation=[1.0, 0.0, 0.0])
-    >>> type(compose(T, S)).__name__, type(compose(S, rk.Projective.identity())).__name__
-    ('Similarity', 'Projective')
-    """
-    ra, rb = _rank(a), _rank(b)
-    if ra < 0 or rb < 0:
-        raise TypeError(
-            f"cannot compose {type(a).__name__} with {type(b).__name__}: both must be "
-            "Rotation, Transform, Similarity, Affine or Projective"
-        )
-    kind = _ladder()[max(ra, rb)]
-    return kind._include(a)._compose(kind._include(b))
-
-
-def homogeneous_matrix(x):
-    """The 4x4 homogeneous matrix of any kind on the ladder (``[[R, 0], [0, 1]]`` for a
-    rotation)."""
-    if _rank(x) == 0:
-        R = x.as_matrix()
-        xp = namespace_of(R)
-        M = xp.zeros(tuple(R.shape[:-2]) + (4, 4), dtype=R.dtype, device=device_of(R))
-        if isinstance(M, np.ndarray):
-            M[..., :3, :3] = R
-            M[..., 3, 3] = 1.0
-            return M
-        col = xp.zeros(tuple(R.shape[:-1]) + (1,), dtype=R.dtype, device=device_of(R))
-        top = xp.concat([R, col], axis=-1)
-        last = xp.asarray([0.0, 0.0, 0.0, 1.0], dtype=R.dtype, device=device_of(R))
-        last = xp.broadcast_to(last, tuple(R.shape[:-2]) + (1, 4))
-        return xp.concat([top, last], axis=-2)
-    return x.as_matrix()
-
-
-def _include_check(cls, x, what):
-    r = _rank(x)
-    if r < 0 or r > _ladder().index(cls):
-        raise TypeError(f"{what} takes a transform of a kind included in {cls.__name__}")
-
-
-class _LadderMember:
-    """``@`` for the kinds defined here: composition through :func:`compose`, or points."""
-
-    __slots__ = ()
-    # NumPy's binary operators defer to us (ndarray @ X reaches __rmatmul__).
-    __array_ufunc__ = None
-    __rmatmul_rigidkit__ = True  # marks us for Transform (and Rotation) to defer to
-
-    def __matmul__(self, other):
-        if type(other) is type(self):  # the common case, without ranking
-            return self._compose(other)
-        if _rank(other) >= 0:
-            return compose(self, other)
-        return self.apply(other)
-
-    def __rmatmul__(self, other):
-        if _rank(other) >= 0:
-            return compose(other, self)
-        name = type(self).__name__
-        raise TypeError(f"array @ {name} is not defined; transform points with X @ p")
-
-
-# -- tolerances ------------------------------------------------------------------------
-
-
-def singular_rtol(dtype) -> float:
-    """Default Hadamard-ratio threshold below which a matrix counts as singular.
-
-    The ratio ``|det A| / prod |row_i|`` is about ``1 / cond`` of ``A`` with
-    normalised rows (see :mod:`rigidkit.kernels.homogeneous`); below 1e-12
-    (float64) or 1e-5 (float32) an inverse keeps fewer than about 4 (resp. 2)
-    correct digits, so we refuse it.
-    """
-    return 1e-5 if is_float32(dtype) else 1e-12
-
-
-def infinity_rtol(dtype) -> float:
-    """Default threshold of ``|w| / max|x, y, z, w|`` below which a point is at infinity.
-
-    64 eps of the dtype: ``w`` is then within a few dozen roundings of zero, so
-    its sign, and the side of infinity the point lies on, are noise.
-    """
-    return _INF_RTOL_32 if is_float32(dtype) else _INF_RTOL_64
-
-
-_INF_RTOL_32 = 64.0 * float(np.finfo(np.float32).eps)
-_INF_RTOL_64 = 64.0 * float(np.finfo(np.float64).eps)
-
-
-def check_invertible(ratio, rtol, what):
-    """Raise :class:`SingularMatrixError` where the Hadamard ``ratio`` is <= ``rtol``."""
-    bad = ratio <= rtol
-    if any_true(bad):
-        idx = batch_index(bad)
-        r = float(_to_numpy(ratio)[idx])
-        raise SingularMatrixError(
-            f"{what} {where_text(idx)} is singular: |det| / prod(|row|) = {r:.3g} "
-            f"<= {rtol:g}"
-        )
+__all__ = ["Projective", "SingularMatrixError", "PointAtInfinityError"]
 
 
 # -- the class -----------------------------------------------------------------------------
 
 
-class Projective(BatchedArray, _LadderMember):
+class Projective(BatchedArray, Group, family="space", rank=4):
     """A batch of invertible projective transforms of 3D space, one 4x4 matrix each.
 
     ``p -> (x, y, z) / w`` with ``(x, y, z, w) = H [p; 1]``; ``H`` and ``c H`` act the
@@ -210,6 +69,7 @@ class Projective(BatchedArray, _LadderMember):
 
     __slots__ = ("_data",)
     _trail = (4, 4)
+    _identity = np.eye(4)
 
     def __init__(self, matrix, *, rtol=None):
         H = as_float(as_array(matrix, (4, 4), "projective matrix"))
@@ -226,17 +86,11 @@ class Projective(BatchedArray, _LadderMember):
     @classmethod
     def from_affine(cls, affine):
         """The inclusion: an :class:`~rigidkit.Affine` (or any kind below it) as ``H``."""
-        _include_check(cls, affine, "Projective.from_affine")
-        return cls._include(affine)
+        return cls.include(affine)
 
     @classmethod
     def _include(cls, x):
-        return x if type(x) is cls else cls._wrap(homogeneous_matrix(x))
-
-    @classmethod
-    def identity(cls, shape=(), *, dtype=None):
-        """Identity transforms of batch ``shape``."""
-        return cls._wrap(cls._filled(np.eye(4), shape, dtype))
+        return cls._wrap(homogeneous_matrix(x))
 
     @classmethod
     def random(cls, shape=(), rng=None, *, dtype=None):
@@ -257,7 +111,8 @@ class Projective(BatchedArray, _LadderMember):
         return self
 
     # -- operations ----------------------------------------------------------------------
-    def _compose(self, other):
+    def compose(self, other):
+        """``self @ other`` (``other`` applied first) for another ``Projective``."""
         return Projective._wrap(_k.projective_compose(self._data, other._data))
 
     def inv(self, *, rtol=None):
@@ -286,19 +141,20 @@ class Projective(BatchedArray, _LadderMember):
         out, ratio = _k.projective_apply(self._data, p)
         tol = infinity_rtol(out.dtype) if rtol is None else rtol
         far = ratio <= tol
-        if any_true(far):
-            xp = namespace_of(far)
-            if at_infinity == "raise":
-                idx = batch_index(far)
-                r = float(_to_numpy(ratio)[idx])
-                raise PointAtInfinityError(
-                    f"projective transform maps the point {where_text(idx)} to infinity: "
-                    f"|w| / max(|x|, |y|, |z|, |w|) = {r:.3g} <= {tol:.3g}; "
-                    'apply(..., at_infinity="nan") marks such points with NaN instead'
-                )
-            nan = xp.asarray(float("nan"), dtype=out.dtype, device=device_of(out))
-            out = xp.where(far[..., None], nan, out)
-        return out
+        if not any_true(far):
+            return out
+        if at_infinity == "raise":
+            raise_where(
+                far,
+                PointAtInfinityError,
+                "projective transform maps the point {where} to infinity: |w| / "
+                f"max(|x|, |y|, |z|, |w|) = {{value:.3g}} <= {tol:.3g}; "
+                'apply(..., at_infinity="nan") marks such points with NaN instead',
+                value=ratio,
+            )
+        xp = namespace_of(far)
+        nan = xp.asarray(float("nan"), dtype=out.dtype, device=device_of(out))
+        return xp.where(far[..., None], nan, out)
 
     def apply_homogeneous(self, points):
         """``H [p; 1]``, shape (..., 4): the images before the homogeneous divide."""
@@ -309,7 +165,7 @@ class Projective(BatchedArray, _LadderMember):
 
         Each matrix is divided by its Frobenius norm and the sign is chosen to match.
         """
-        other = Projective._include(other)
+        other = Projective.include(other)
         xp = namespace_of(self._data, other._data)
         a = self._data / xp.sqrt(xp.sum(self._data**2, axis=(-2, -1)))[..., None, None]
         b = other._data / xp.sqrt(xp.sum(other._data**2, axis=(-2, -1)))[..., None, None]
@@ -320,4 +176,4 @@ class Projective(BatchedArray, _LadderMember):
 
     # -- container protocol (shape, len, [], reshape, ...): BatchedArray ------------------
     def _repr_single(self):
-        return f"Projective({_to_numpy(self._data).tolist()!r})"
+        return f"Projective({to_numpy(self._data).tolist()!r})"

@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._engine.namespace import is_numpy, namespace_of
-from .._validate import _to_numpy, as_array, check_finite
+from .._validate import as_array, check_finite, to_numpy
 from ..functional import quaternion as _fq
 from ._batch import BatchedArray
 from .rotation import Rotation
@@ -134,7 +134,7 @@ class Quaternion(BatchedArray):
         return self._q[..., 1:]
 
     def __array__(self, dtype=None, copy=None):
-        a = _to_numpy(self._q)
+        a = to_numpy(self._q)
         if dtype is not None:
             a = a.astype(dtype, copy=False)
         return a.copy() if copy else a
@@ -247,5 +247,5 @@ class Quaternion(BatchedArray):
 
     # -- container protocol (shape, len, [], reshape, ...): BatchedArray ------------------
     def _repr_single(self):
-        vals = ", ".join(repr(c) for c in _to_numpy(self._q).tolist())
+        vals = ", ".join(repr(c) for c in to_numpy(self._q).tolist())
         return f"Quaternion([{vals}])"

@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from .._validate import _to_numpy, as_array
+from .._validate import as_array, to_numpy
 from ..functional import averaging as _avg
 from ..functional import conversions as _conv
 from ..functional import euler
@@ -23,7 +23,7 @@ from .group import LieGroup
 __all__ = ["Rotation"]
 
 
-class Rotation(BatchedArray, LieGroup):
+class Rotation(BatchedArray, LieGroup, family="space", rank=0):
     """A batch of 3D rotations of any shape, one unit quaternion each.
 
     Conventions: Hamilton quaternions ``(w, x, y, z)``; active rotations on column
@@ -45,10 +45,8 @@ class Rotation(BatchedArray, LieGroup):
     __slots__ = ("_quat",)
     _storage = "_quat"
     _trail = (4,)
-    dof = 3
-    matrix_size = 3
-    point_dim = 3
-    __array_priority__ = 1000  # so ndarray @ Rotation defers to us (and fails clearly)
+    _identity = (1.0, 0.0, 0.0, 0.0)
+    dof, matrix_size, point_dim = 3, 3, 3
 
     def __init__(self, quat, *, _normalized=False):
         if not _normalized:
@@ -123,11 +121,6 @@ class Rotation(BatchedArray, LieGroup):
         return cls._wrap(euler.quat_from_euler(seq, angles, degrees=degrees))
 
     @classmethod
-    def identity(cls, shape=(), *, dtype=None):
-        """Identity rotations of batch ``shape`` (``()`` for one)."""
-        return cls._wrap(cls._filled([1.0, 0.0, 0.0, 0.0], shape, dtype))
-
-    @classmethod
     def random(cls, shape=(), rng=None, *, dtype=None):
         """Uniformly distributed (Haar) rotations, from a normalised 4D Gaussian.
 
@@ -146,11 +139,11 @@ class Rotation(BatchedArray, LieGroup):
 
     def as_matrix(self, *, out=None):
         """Rotation matrices, shape (..., 3, 3), ``v_A = A_R_B @ v_B``."""
-        return _conv.matrix_from_quat(self._quat, out=out)
+        return _conv.matrix_from_quat_unchecked(self._quat, out=out)
 
     def as_rotvec(self, *, degrees=False):
         """Rotation vectors ``angle * axis``, angle in [0, pi], shape (..., 3)."""
-        r = _conv.rotvec_from_quat(self._quat)
+        r = _conv.rotvec_from_quat_unchecked(self._quat)
         return r * (180.0 / math.pi) if degrees else r
 
     def log(self):
@@ -166,12 +159,12 @@ class Rotation(BatchedArray, LieGroup):
 
         The identity has axis ``+x`` and angle 0.
         """
-        axis, angle = _conv.axis_angle_from_quat(self._quat)
+        axis, angle = _conv.axis_angle_from_quat_unchecked(self._quat)
         return axis, (angle * (180.0 / math.pi) if degrees else angle)
 
     def as_mrp(self):
         """Modified Rodrigues parameters ``axis * tan(angle / 4)``, norm <= 1."""
-        return _conv.mrp_from_quat(self._quat)
+        return _conv.mrp_from_quat_unchecked(self._quat)
 
     def as_euler(self, seq, *, degrees=False):
         """Euler angles for ``seq`` (UPPER intrinsic, lower extrinsic), shape (..., 3).
@@ -196,14 +189,7 @@ class Rotation(BatchedArray, LieGroup):
         return self.as_axis_angle()[0]
 
     # -- group operations ----------------------------------------------------------
-    def __matmul__(self, other):
-        """``R1 @ R2`` composes (``R2`` first); ``R @ v`` rotates vectors (..., 3)."""
-        if isinstance(other, Rotation):
-            return Rotation._wrap(_conv.quat_multiply(self._quat, other._quat))
-        if isinstance(other, LieGroup) or hasattr(other, "__rmatmul_rigidkit__"):
-            return NotImplemented  # e.g. Rotation @ Affine: the more general kind decides
-        return self.apply(other)
-
+    # ``R1 @ R2`` composes (``R2`` first) and ``R @ v`` rotates vectors: Group.__matmul__.
     def compose(self, other, *, out=None):
         """``self @ other`` (``other`` first), optionally into a quaternion buffer.
 
@@ -212,15 +198,10 @@ class Rotation(BatchedArray, LieGroup):
         """
         return Rotation._wrap(_conv.quat_multiply(self._quat, other._quat, out=out))
 
-    def __rmatmul__(self, other):
-        raise TypeError(
-            "array @ Rotation is not defined; rotate vectors with R @ v or R.apply(v)"
-        )
-
     def apply(self, vectors, *, out=None):
         """Rotate vectors, shape (..., 3) broadcasting with the rotation's shape."""
         v = as_array(vectors, (3,), "vectors")
-        return _conv.quat_apply(self._quat, v, out=out)
+        return _conv.quat_apply_unchecked(self._quat, v, out=out)
 
     def inv(self):
         """Inverse rotations (conjugate quaternions)."""
@@ -231,7 +212,7 @@ class Rotation(BatchedArray, LieGroup):
 
         ``q`` and ``-q`` are the same rotation and compare equal.
         """
-        return _conv.quat_angle_between(self._quat, other._quat) <= atol
+        return _conv.quat_angle_between_unchecked(self._quat, other._quat) <= atol
 
     def magnitude(self):
         """Rotation angle in [0, pi] (same as :attr:`angle`)."""
@@ -268,5 +249,5 @@ class Rotation(BatchedArray, LieGroup):
 
     # -- container protocol (shape, len, [], reshape, ...): BatchedArray ------------------
     def _repr_single(self):
-        vals = ", ".join(f"{c:.6g}" for c in _to_numpy(self._quat).tolist())
+        vals = ", ".join(f"{c:.6g}" for c in to_numpy(self._quat).tolist())
         return f"Rotation.from_quat([{vals}])"

@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 from .._engine.namespace import is_numpy, is_torch, namespace_of
-from .._validate import _to_numpy, as_array, check_finite, finite_array
+from .._validate import as_array, check_finite, finite_array, to_numpy
 from ..errors import ShapeError
 from ..functional import so2 as _so2
 from ..kernels import so2 as _k
@@ -24,7 +24,7 @@ from .group import LieGroup
 __all__ = ["Rotation2D"]
 
 
-class Rotation2D(BatchedArray, LieGroup):
+class Rotation2D(BatchedArray, LieGroup, family="plane", rank=0):
     """A batch of planar rotations of any shape, one unit complex number each.
 
     Stored as ``(cos θ, sin θ)``, shape (..., 2). Rotations are active and act on
@@ -52,10 +52,8 @@ class Rotation2D(BatchedArray, LieGroup):
 
     __slots__ = ("_data",)
     _trail = (2,)
-    dof = 1
-    matrix_size = 2
-    point_dim = 2
-    __array_priority__ = 1000  # so ndarray @ Rotation2D defers to us (and fails clearly)
+    _identity = (1.0, 0.0)  # (cos 0, sin 0)
+    dof, matrix_size, point_dim = 1, 2, 2
 
     def __init__(self, cos_sin):
         self._data = _so2.complex_normalize(cos_sin, what="(cos, sin) pair")
@@ -118,11 +116,6 @@ class Rotation2D(BatchedArray, LieGroup):
         )
 
     @classmethod
-    def identity(cls, shape=(), *, dtype=None):
-        """Identity rotations of batch ``shape`` (``()`` for one)."""
-        return cls._wrap(cls._filled([1.0, 0.0], shape, dtype))
-
-    @classmethod
     def random(cls, shape=(), rng=None, *, dtype=None):
         """Uniformly distributed (Haar) rotations: angles uniform in [-pi, pi).
 
@@ -171,18 +164,10 @@ class Rotation2D(BatchedArray, LieGroup):
         return _k.adjoint_from_complex(self._data)
 
     # -- group operations ----------------------------------------------------------
-    def __matmul__(self, other):
-        """``R1 @ R2`` composes (``R2`` first); ``R @ p`` rotates points (..., 2)."""
-        if isinstance(other, Rotation2D):
-            return Rotation2D._wrap(_k.complex_multiply(self._data, other._data))
-        if isinstance(other, LieGroup) or hasattr(other, "__rmatmul_rigidkit__"):
-            return NotImplemented
-        return self.apply(other)
-
-    def __rmatmul__(self, other):
-        raise TypeError(
-            "array @ Rotation2D is not defined; rotate points with R @ p or R.apply(p)"
-        )
+    # ``R1 @ R2`` composes (``R2`` first) and ``R @ p`` rotates points: Group.__matmul__.
+    def compose(self, other, *, out=None):
+        """``self @ other`` (``other`` first), optionally into a ``(cos, sin)`` buffer."""
+        return Rotation2D._wrap(_k.complex_multiply(self._data, other._data, out=out))
 
     def apply(self, points, *, out=None):
         """Rotate points, shape (..., 2) broadcasting with the rotation's shape."""
@@ -199,4 +184,4 @@ class Rotation2D(BatchedArray, LieGroup):
 
     # -- container protocol (shape, len, [], reshape, ...): BatchedArray ------------------
     def _repr_single(self):
-        return f"Rotation2D.from_angle({float(_to_numpy(self.angle)):.6g})"
+        return f"Rotation2D.from_angle({float(to_numpy(self.angle)):.6g})"

@@ -17,21 +17,22 @@ from __future__ import annotations
 import numpy as np
 
 from .._engine.namespace import device_of, namespace_of
-from .._validate import _to_numpy, as_array, as_float, batch_index, check_finite, where_text
+from .._validate import as_array, as_float, check_finite, raise_where, to_numpy
 from ..errors import NotASimilarityError
 from ..functional import conversions as _conv
 from ..functional import sim3 as _fsim3
 from ..kernels import sim3 as _k
 from ._batch import BatchedArray, batch_shape
+from .affine import Affine
 from .group import LieGroup
-from .projective import _include_check, _LadderMember, _rank
+from .projective import Projective
 from .rotation import Rotation
 from .transform import pose_gap
 
 __all__ = ["Similarity", "NotASimilarityError"]
 
 
-class Similarity(BatchedArray, _LadderMember, LieGroup):
+class Similarity(BatchedArray, LieGroup, family="space", rank=2):
     """A batch of similarity transforms ``p -> s R p + t`` (the group Sim(3)).
 
     ``S1 @ S2`` applies ``S2`` first: ``(s1 s2, R1 R2, s1 R1 t2 + t1)``; ``S @ p``
@@ -63,9 +64,8 @@ class Similarity(BatchedArray, _LadderMember, LieGroup):
 
     __slots__ = ("_data",)
     _trail = (8,)
-    dof = 7
-    matrix_size = 4
-    point_dim = 3
+    _identity = (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)  # (q, t, s)
+    dof, matrix_size, point_dim = 7, 4, 3
 
     def __init__(self, scale=None, rotation=None, translation=None):
         if rotation is not None and not isinstance(rotation, Rotation):
@@ -112,14 +112,11 @@ class Similarity(BatchedArray, _LadderMember, LieGroup):
     @classmethod
     def from_transform(cls, transform):
         """The inclusion: a :class:`~rigidkit.Transform` (or ``Rotation``), ``s = 1``."""
-        _include_check(cls, transform, "Similarity.from_transform")
-        return cls._include(transform)
+        return cls.include(transform)
 
     @classmethod
     def _include(cls, x):
-        if type(x) is cls:
-            return x
-        if _rank(x) == 0:
+        if isinstance(x, Rotation):
             return cls(rotation=x)
         q, t = x.rotation.as_quat(), x.translation
         ones = t[..., :1] * 0.0 + 1.0  # (t is finite; the torch adapter has no ones_like)
@@ -152,12 +149,6 @@ class Similarity(BatchedArray, _LadderMember, LieGroup):
         xi = as_float(as_array(tau, (7,), "sim(3) twist"))
         check_finite(xi, (7,), "sim(3) twist")
         return cls._wrap(_k.sim3_exp(xi))
-
-    @classmethod
-    def identity(cls, shape=(), *, dtype=None):
-        """Identity transforms of batch ``shape`` (``()`` for one)."""
-        identity = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]  # (q, t, s)
-        return cls._wrap(cls._filled(identity, shape, dtype))
 
     @classmethod
     def random(cls, shape=(), rng=None, *, dtype=None):
@@ -196,15 +187,11 @@ class Similarity(BatchedArray, _LadderMember, LieGroup):
 
     def as_affine(self):
         """The same transforms as :class:`~rigidkit.Affine`."""
-        from .affine import Affine
-
-        return Affine._include(self)
+        return Affine.include(self)
 
     def as_projective(self):
         """The same transforms as :class:`~rigidkit.Projective`."""
-        from .projective import Projective
-
-        return Projective._include(self)
+        return Projective.include(self)
 
     def log(self):
         """Twists ``(v, omega, log s)``, shape (..., 7), ``|omega|`` in [0, pi].
@@ -222,7 +209,8 @@ class Similarity(BatchedArray, _LadderMember, LieGroup):
         return _k.sim3_adjoint(self._data)
 
     # -- group operations ---------------------------------------------------------------
-    def _compose(self, other):
+    def compose(self, other):
+        """``self @ other`` (``other`` applied first) for another ``Similarity``."""
         return Similarity._wrap(_k.sim3_compose(self._data, other._data))
 
     def apply(self, points):
@@ -235,7 +223,7 @@ class Similarity(BatchedArray, _LadderMember, LieGroup):
 
     def approx_equal(self, other, *, atol=1e-8):
         """Elementwise: rotation angle, translation gap and |log(s1/s2)| all <= ``atol``."""
-        other = Similarity._include(other)
+        other = Similarity.include(other)
         a, b = self._data, other._data
         angle, dist = pose_gap(a, b)
         xp = namespace_of(angle)
@@ -244,7 +232,7 @@ class Similarity(BatchedArray, _LadderMember, LieGroup):
 
     # -- container protocol (shape, len, [], reshape, ...): BatchedArray ------------------
     def _repr_single(self):
-        d = _to_numpy(self._data).tolist()
+        d = to_numpy(self._data).tolist()
         q = ", ".join(f"{c:.6g}" for c in d[:4])
         t = ", ".join(f"{c:.6g}" for c in d[4:7])
         return (
@@ -258,14 +246,12 @@ def _check_positive(s):
         if not s > 0:
             raise NotASimilarityError(f"scale must be positive, got {s!r}")
         return
-    xp = namespace_of(s)
-    bad = ~(s > 0)
-    if bool(xp.any(bad)):
-        idx = batch_index(bad)
-        val = float(_to_numpy(s)[idx])
-        raise NotASimilarityError(
-            f"scale {where_text(idx)} is {val:g}; it must be positive"
-        )
+    raise_where(
+        ~(s > 0),
+        NotASimilarityError,
+        "scale {where} is {value:g}; it must be positive",
+        value=s,
+    )
 
 
 def _assemble(q, t, s):

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._engine.namespace import device_of, namespace_of
-from .._validate import _to_numpy, as_array, finite_array
+from .._validate import as_array, finite_array, to_numpy
 from ..functional import averaging as _avg
 from ..functional import conversions as _conv
 from ..functional import interpolation as _interp
@@ -25,7 +25,7 @@ from .rotation import Rotation
 __all__ = ["Transform"]
 
 
-class Transform(BatchedArray, LieGroup):
+class Transform(BatchedArray, LieGroup, family="space", rank=1):
     """A batch of rigid motions of any shape: ``p -> R p + t``.
 
     Stored as one array of shape ``(..., 7)``: a unit quaternion ``(w, x, y, z)``
@@ -61,12 +61,8 @@ class Transform(BatchedArray, LieGroup):
     __slots__ = ("_pose",)
     _storage = "_pose"
     _trail = (7,)
-    dof = 6
-    matrix_size = 4
-    point_dim = 3
-    algebra = _se3
-    __array_priority__ = 1000  # so ndarray @ Transform defers to us (and fails clearly)
-    __rmatmul_rigidkit__ = True  # Rotation @ Transform reaches our __rmatmul__
+    _identity = (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)  # (w, x, y, z, tx, ty, tz)
+    dof, matrix_size, point_dim = 6, 4, 3
 
     def __init__(self, rotation=None, translation=None):
         if rotation is not None and not isinstance(rotation, Rotation):
@@ -76,7 +72,7 @@ class Transform(BatchedArray, LieGroup):
         if translation is not None:
             translation = finite_array(translation, (3,), "translation")
         if rotation is None and translation is None:
-            self._pose = self._filled(_IDENTITY, ())
+            self._pose = self._filled(self._identity, ())
             return
         if rotation is None:
             quat = _constant_like(translation, [1.0, 0.0, 0.0, 0.0])
@@ -113,11 +109,6 @@ class Transform(BatchedArray, LieGroup):
         ``w`` in radians. See :func:`rigidkit.se3.exp`.
         """
         return cls._wrap(_se3.pose_from_twist(xi))
-
-    @classmethod
-    def identity(cls, shape=(), *, dtype=None):
-        """Identity transforms of batch ``shape`` (``()`` for one)."""
-        return cls._wrap(cls._filled(_IDENTITY, shape, dtype))
 
     @classmethod
     def random(cls, shape=(), rng=None, *, dtype=None, scale=1.0):
@@ -163,25 +154,11 @@ class Transform(BatchedArray, LieGroup):
         return self._pose[..., 4:]
 
     # -- group operations --------------------------------------------------------------
-    def __matmul__(self, other):
-        """``T1 @ T2`` composes (``T2`` first); ``T @ p`` moves points (..., 3).
-
-        A :class:`Rotation` on either side is the transform with zero translation.
-        """
-        if isinstance(other, Transform):
-            return Transform._wrap(_k.pose_compose(self._pose, other._pose))
-        if isinstance(other, Rotation):
-            return self @ Transform(rotation=other)
-        if isinstance(other, LieGroup) or hasattr(other, "__rmatmul_rigidkit__"):
-            return NotImplemented
-        return self.apply(other)
-
-    def __rmatmul__(self, other):
-        if isinstance(other, Rotation):
-            return Transform(rotation=other) @ self
-        raise TypeError(
-            "array @ Transform is not defined; move points with T @ p or T.apply(p)"
-        )
+    # ``T1 @ T2`` composes (``T2`` first) and ``T @ p`` moves points: Group.__matmul__.
+    # A Rotation on either side is the transform with zero translation (_include).
+    @classmethod
+    def _include(cls, x):
+        return cls(rotation=x)
 
     def compose(self, other, *, out=None):
         """``self @ other`` (``other`` first), optionally into a pose buffer.
@@ -237,10 +214,11 @@ class Transform(BatchedArray, LieGroup):
         )
         return (
             (Transform._wrap(p), {"iterations": k}) if return_info else Transform._wrap(p)
+        )
 
     # -- container protocol (shape, len, [], reshape, ...): BatchedArray ------------------
     def _repr_single(self):
-        p = _to_numpy(self._pose).tolist()
+        p = to_numpy(self._pose).tolist()
         q = ", ".join(f"{c:.6g}" for c in p[:4])
         t = ", ".join(f"{c:.6g}" for c in p[4:])
         return f"Transform(rotation=Rotation.from_quat([{q}]), translation=[{t}])"
@@ -287,13 +265,10 @@ def pose_gap(a, b):
     Reads ``(w, x, y, z, tx, ty, tz)`` from the first 7 components of the last axis
     (so also the rigid part of a similarity's ``(q, t, s)``); shapes broadcast.
     """
-    angle = _conv.quat_angle_between(a[..., :4], b[..., :4])
+    angle = _conv.quat_angle_between_unchecked(a[..., :4], b[..., :4])
     xp = namespace_of(angle)
     d = a[..., 4:7] - b[..., 4:7]
     return angle, xp.sqrt(xp.sum(d * d, axis=-1))
-
-
-_IDENTITY = (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)  # (w, x, y, z, tx, ty, tz)
 
 
 def _constant_like(a, values):

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._engine.namespace import float_dtype_of, namespace_of
-from .._validate import _to_numpy, as_array, finite_array
+from .._validate import as_array, finite_array, to_numpy
 from ..functional import se2 as _se2
 from ..kernels import se2 as _k
 from ._batch import BatchedArray, batch_shape
@@ -21,7 +21,7 @@ from .rotation2d import Rotation2D
 __all__ = ["Transform2D"]
 
 
-class Transform2D(BatchedArray, LieGroup):
+class Transform2D(BatchedArray, LieGroup, family="plane", rank=1):
     """A batch of planar rigid motions ``p -> R p + t`` of any batch shape.
 
     Parameters
@@ -55,10 +55,8 @@ class Transform2D(BatchedArray, LieGroup):
 
     __slots__ = ("_data",)
     _trail = (4,)
-    dof = 3
-    matrix_size = 3
-    point_dim = 2
-    __array_priority__ = 1000  # so ndarray @ Transform2D defers to us (and fails clearly)
+    _identity = (1.0, 0.0, 0.0, 0.0)  # (cos 0, sin 0, tx, ty)
+    dof, matrix_size, point_dim = 3, 3, 2
 
     def __init__(self, rotation=None, translation=None):
         if rotation is not None and not isinstance(rotation, Rotation2D):
@@ -108,11 +106,6 @@ class Transform2D(BatchedArray, LieGroup):
         return cls._wrap(_k.pose_from_twist(xi))
 
     @classmethod
-    def identity(cls, shape=(), *, dtype=None):
-        """Identity motions of batch ``shape`` (``()`` for one)."""
-        return cls._wrap(cls._filled([1.0, 0.0, 0.0, 0.0], shape, dtype))
-
-    @classmethod
     def random(cls, shape=(), rng=None, *, dtype=None):
         """Random motions: Haar rotations and standard normal translations.
 
@@ -151,23 +144,15 @@ class Transform2D(BatchedArray, LieGroup):
         return _k.adjoint_from_pose(self._data)
 
     # -- group operations ----------------------------------------------------------
-    def __matmul__(self, other):
-        """``T1 @ T2`` composes (``T2`` first; ``T2`` may be a Rotation2D);
-        ``T @ p`` maps points (..., 2)."""
-        if isinstance(other, Transform2D):
-            return Transform2D._wrap(_k.pose_multiply(self._data, other._data))
-        if isinstance(other, Rotation2D):
-            return self @ Transform2D(rotation=other)
-        if isinstance(other, LieGroup) or hasattr(other, "__rmatmul_rigidkit__"):
-            return NotImplemented
-        return self.apply(other)
+    # ``T1 @ T2`` composes (``T2`` first; either may be a Rotation2D) and ``T @ p``
+    # maps points: Group.__matmul__.
+    def compose(self, other, *, out=None):
+        """``self @ other`` (``other`` first), optionally into a pose buffer."""
+        return Transform2D._wrap(_k.pose_multiply(self._data, other._data, out=out))
 
-    def __rmatmul__(self, other):
-        if isinstance(other, Rotation2D):
-            return Transform2D(rotation=other) @ self
-        raise TypeError(
-            "array @ Transform2D is not defined; map points with T @ p or T.apply(p)"
-        )
+    @classmethod
+    def _include(cls, x):
+        return cls(rotation=x)
 
     def apply(self, points, *, out=None):
         """Map points ``R p + t``, shape (..., 2) broadcasting with the batch shape."""
@@ -185,5 +170,5 @@ class Transform2D(BatchedArray, LieGroup):
 
     # -- container protocol (shape, len, [], reshape, ...): BatchedArray ------------------
     def _repr_single(self):
-        t = ", ".join(f"{v:.6g}" for v in _to_numpy(self.translation).tolist())
+        t = ", ".join(f"{v:.6g}" for v in to_numpy(self.translation).tolist())
         return f"Transform2D(rotation={self.rotation!r}, translation=[{t}])"
