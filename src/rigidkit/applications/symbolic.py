@@ -248,3 +248,13 @@ for _module, _fns in _BY_MODULE.items():
         globals()[_module] = types.SimpleNamespace(**_fns)
 
 __all__ = sorted(_TOP) + sorted(m for m in _BY_MODULE if m not in _TOP)
+
+# The kinematics derivations (issue 8) live in their own module.
+from .symbolic_kinematics import (  # noqa: E402
+    euler_matrix,
+    euler_rate_matrix,
+    quaternion_matrix,
+    twist_exp,
+)
+
+__all__ += ["euler_matrix", "euler_rate_matrix", "quaternion_matrix", "twist_exp"]
