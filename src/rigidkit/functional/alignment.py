@@ -73,9 +73,11 @@ def _pairs(a, b, weights, what):
     dtype = a.dtype if a.dtype == b.dtype else xp.float64
     a = xp.asarray(a, dtype=dtype)
     b = xp.asarray(b, dtype=dtype, device=device_of(a))
-    shape = np.broadcast_shapes(tuple(a.shape), tuple(b.shape))
-    a = xp.broadcast_to(a, shape)
-    b = xp.broadcast_to(b, shape)
+    shape = tuple(a.shape)
+    if shape != tuple(b.shape):
+        shape = np.broadcast_shapes(shape, tuple(b.shape))
+        a = xp.broadcast_to(a, shape)
+        b = xp.broadcast_to(b, shape)
     if shape[-2] == 0:
         raise DegenerateInputError(f"{what}: no pairs given (N = 0)")
     w = None
@@ -114,7 +116,7 @@ def _rotation(xp, h):
 
 
 def _rssd(xp, a, b, q, w):
-    res = a - _kq.quat_apply(q[..., None, :], b)
+    res = a - b @ _kmat.matrix_from_quat(q).mT
     sq = xp.sum(res * res, axis=-1)
     if w is not None:
         sq = sq * w
@@ -148,9 +150,8 @@ def kabsch(a, b, weights=None):
     xp, a, b, w = _pairs(a, b, weights, "vectors")
     aw = a if w is None else a * w[..., None]
     h = aw.mT @ b  # sum_i w_i a_i b_i^T
-    scale = xp.max(xp.abs(xp.reshape(h, tuple(h.shape[:-2]) + (9,))), axis=-1)
-    _zero_check(xp, scale, "vectors: all pairs are zero or have zero weight")
-    q, _, _, _ = _rotation(xp, h)
+    q, s, _, _ = _rotation(xp, h)
+    _zero_check(xp, s[..., 0], "vectors: all pairs are zero or have zero weight")
     return q, _rssd(xp, a, b, q, w)
 
 
