@@ -71,27 +71,31 @@ def right_jacobians(module, group, dof, tangent, left, left_inverse):
     def right_jacobian_inverse(x):
         return left_inverse(-finite_array(x, (dof,), tangent))
 
-    right_jacobian.__doc__ = _DOC.format(
-        title="Right Jacobian",
-        group=group,
-        relation="``exp(x + d) ~ exp(x) exp(J_r(x) d)``",
-        symbol="J_r",
-        left="J_l",
-        dof=dof,
-        tangent=tangent.capitalize(),
-        see_also="left_jacobian, right_jacobian_inverse",
-    )
-    right_jacobian_inverse.__doc__ = _DOC.format(
-        title="Inverse of the right Jacobian",
-        group=group,
-        relation="``log(exp(x) exp(d)) ~ x + J_r(x)^-1 d``",
-        symbol="J_r^-1",
-        left="J_l^-1",
-        dof=dof,
-        tangent=tangent.capitalize(),
-        see_also="left_jacobian_inverse, right_jacobian",
-    )
-    for fn in (right_jacobian, right_jacobian_inverse):
+    docs = {
+        right_jacobian: (
+            "Right Jacobian",
+            "``exp(x + d) ~ exp(x) exp(J_r(x) d)``",
+            "J_r",
+            "left_jacobian, right_jacobian_inverse",
+        ),
+        right_jacobian_inverse: (
+            "Inverse of the right Jacobian",
+            "``log(exp(x) exp(d)) ~ x + J_r(x)^-1 d``",
+            "J_r^-1",
+            "left_jacobian_inverse, right_jacobian",
+        ),
+    }
+    for fn, (title, relation, symbol, see_also) in docs.items():
+        fn.__doc__ = _DOC.format(
+            title=title,
+            group=group,
+            relation=relation,
+            symbol=symbol,
+            left=symbol.replace("_r", "_l"),
+            dof=dof,
+            tangent=tangent.capitalize(),
+            see_also=see_also,
+        )
         fn.__module__ = module
         fn.__qualname__ = fn.__name__
     return right_jacobian, right_jacobian_inverse

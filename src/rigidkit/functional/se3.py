@@ -49,37 +49,18 @@ def _twist(xi, what="twist"):
 
 
 def hat(xi):
-    """``hat(V) = [[hat(w), v], [0, 0]]`` of twists ``V = (v, w)``.
+    """``hat(V) = [[hat(w), v], [0, 0]]`` of twists ``V = (v, w)``: (..., 6) -> (..., 4, 4).
 
-    Parameters
-    ----------
-    xi : array_like, shape (..., 6)
-
-    Returns
-    -------
-    ndarray, shape (..., 4, 4)
-
-    See Also
-    --------
-    vee
+    The inverse of :func:`vee`; a linear map, so any real input is accepted.
     """
     return _k.hat(as_array(xi, (6,), "twist"))
 
 
 def vee(X):
-    """Twist ``(v, w)`` of 4x4 se(3) matrices: ``v`` the last column, ``w`` the skew part.
+    """Twist ``(v, w)`` of se(3) matrices: (..., 4, 4) -> (..., 6).
 
-    Parameters
-    ----------
-    X : array_like, shape (..., 4, 4)
-
-    Returns
-    -------
-    ndarray, shape (..., 6)
-
-    See Also
-    --------
-    hat
+    ``v`` is the last column and ``w`` the vector of the skew part of the 3x3 block
+    (its projection onto so(3)); the inverse of :func:`hat`.
     """
     return _k.vee(as_array(X, (4, 4), "se(3) matrix"))
 
@@ -188,17 +169,10 @@ def adjoint(M, *, atol=None):
 
 
 def ad(xi):
-    """Small adjoint ``ad(V) = [[hat(w), hat(v)], [0, hat(w)]]`` of twists ``(v, w)``.
+    """Small adjoint ``ad(V) = [[hat(w), hat(v)], [0, hat(w)]]``: (..., 6) -> (..., 6, 6).
 
-    ``ad(V) @ U == bracket(V, U)``; ``adjoint(exp(V)) == expm(ad(V))``.
-
-    Parameters
-    ----------
-    xi : array_like, shape (..., 6)
-
-    Returns
-    -------
-    ndarray, shape (..., 6, 6)
+    For twists ``(v, w)``: ``ad(V) @ U == bracket(V, U)`` and
+    ``adjoint(exp(V)) == expm(ad(V))``.
     """
     return _k.ad(as_array(xi, (6,), "twist"))
 
@@ -231,10 +205,12 @@ def left_jacobian(xi):
     Parameters
     ----------
     xi : array_like, shape (..., 6)
+        Twists ``(v, w)`` at which the exponential is linearised; finite.
 
     Returns
     -------
     ndarray, shape (..., 6, 6)
+        ``J_l``, acting on twists ``(v, w)``.
 
     See Also
     --------
@@ -246,16 +222,9 @@ def left_jacobian(xi):
 def left_jacobian_inverse(xi):
     """Inverse of :func:`left_jacobian`: ``log(exp(d) exp(V)) ~ V + J_l(V)^-1 d``.
 
-    ``[[J^-1, -J^-1 Q J^-1], [0, J^-1]]`` with ``J = J_l(w)``; finite for
-    ``|w| < 2 pi``.
-
-    Parameters
-    ----------
-    xi : array_like, shape (..., 6)
-
-    Returns
-    -------
-    ndarray, shape (..., 6, 6)
+    ``[[J^-1, -J^-1 Q J^-1], [0, J^-1]]`` with ``J = J_l(w)``, for twists
+    ``(v, w)`` (..., 6) with ``|w| < 2 pi`` (where ``J_l`` is invertible); the
+    result has shape (..., 6, 6).
     """
     return _k.left_jacobian_inverse(_twist(xi))
 

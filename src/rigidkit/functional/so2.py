@@ -123,19 +123,12 @@ def complex_normalize(z, *, what="complex number"):
 def complex_from_matrix(matrix, *, atol=None, orthonormalize=False):
     """Unit complex numbers ``(cos θ, sin θ)`` of 2x2 rotation matrices, validated.
 
-    Parameters
-    ----------
-    matrix : array_like, shape (..., 2, 2)
-        Active rotation matrices acting on column vectors.
-    atol : float, optional
-        Largest accepted ``max(|R^T R - I|, |det R - 1|)``; default 1e-6 (float64)
-        or 1e-4 (float32).
-    orthonormalize : bool
-        Instead of raising, take the nearest rotation in Frobenius norm.
-
-    Returns
-    -------
-    array, shape (..., 2)
+    ``matrix`` (array_like, shape (..., 2, 2)) holds active rotations acting on
+    column vectors; the result has shape (..., 2). ``atol`` is the largest accepted
+    ``max(|R^T R - I|, |det R - 1|)`` (default
+    :func:`rigidkit._validate.default_atol`: 1e-6 for float64, 1e-4 for float32).
+    With ``orthonormalize=True`` the nearest rotation in Frobenius norm is taken
+    instead of raising: ``(m00 + m11, m10 - m01)`` normalised.
 
     Raises
     ------
@@ -143,7 +136,8 @@ def complex_from_matrix(matrix, *, atol=None, orthonormalize=False):
         NaN or inf anywhere.
     NotARotationError
         A matrix is not a rotation within ``atol`` (a reflection, a scaling, a
-        shear), naming the first such batch index and why.
+        shear), or has no unique nearest rotation, naming the first such batch
+        index and why.
     """
     m = finite_array(matrix, (2, 2), "rotation matrix")
     z, norm, err = _k.complex_from_matrix(m)

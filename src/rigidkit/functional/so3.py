@@ -46,11 +46,12 @@ def exp(w):
     Parameters
     ----------
     w : array_like, shape (..., 3)
-        Rotation vectors, radians.
+        Rotation vectors ``angle * axis``, radians; any angle (not only [0, pi]).
 
     Returns
     -------
     ndarray, shape (..., 3, 3)
+        Rotation matrices acting on column vectors.
     """
     return _rv.matrix_from_rotvec(_rotvec(w))
 
@@ -87,15 +88,9 @@ def adjoint(R, *, atol=None):
 
 
 def ad(w):
-    """Small adjoint of so(3), ``hat(w)``: ``ad(u) @ v == bracket(u, v) == u x v``.
+    """Small adjoint of so(3), ``hat(w)``: (..., 3) -> (..., 3, 3).
 
-    Parameters
-    ----------
-    w : array_like, shape (..., 3)
-
-    Returns
-    -------
-    ndarray, shape (..., 3, 3)
+    ``ad(u) @ v == bracket(u, v) == u x v``.
     """
     return hat(w)
 
@@ -150,16 +145,8 @@ def left_jacobian(w):
 def left_jacobian_inverse(w):
     """Inverse of :func:`left_jacobian`: ``log(exp(d) exp(w)) ~ w + J_l(w)^-1 d``.
 
-    ``J_l^-1 = I - hat(w)/2 + (1 - (t/2) cot(t/2))/t^2 hat(w)^2``, finite for
-    ``t = |w| < 2 pi``.
-
-    Parameters
-    ----------
-    w : array_like, shape (..., 3)
-
-    Returns
-    -------
-    ndarray, shape (..., 3, 3)
+    ``J_l^-1 = I - hat(w)/2 + (1 - (t/2) cot(t/2))/t^2 hat(w)^2`` for rotation
+    vectors ``w`` (..., 3), finite for ``t = |w| < 2 pi``; shape (..., 3, 3).
     """
     return _jac.left_jacobian_inverse(_rotvec(w))
 

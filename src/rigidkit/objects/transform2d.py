@@ -27,9 +27,10 @@ class Transform2D(BatchedArray, LieGroup, family="plane", rank=1):
     Parameters
     ----------
     rotation : Rotation2D, optional
-        Rotation part (identity when omitted).
+        The rotation ``R`` (the identity when omitted).
     translation : array_like, shape (..., 2), optional
-        Translation part (zero when omitted). The two batch shapes broadcast.
+        The translation ``t``, finite (zero when omitted). The batch shapes of
+        ``rotation`` and ``translation`` broadcast.
 
     Notes
     -----
@@ -119,14 +120,14 @@ class Transform2D(BatchedArray, LieGroup, family="plane", rank=1):
 
     # -- parts and representations ---------------------------------------------
     @property
-    def rotation(self) -> Rotation2D:
-        """The rotation part, a :class:`Rotation2D` of the same batch shape."""
-        return Rotation2D._wrap(self._data[..., :2])
-
-    @property
     def translation(self):
         """The translation part ``t``, shape (..., 2)."""
         return self._data[..., 2:]
+
+    @property
+    def rotation(self) -> Rotation2D:
+        """The rotation part, a :class:`Rotation2D` of the same batch shape."""
+        return Rotation2D._wrap(self._data[..., :2])
 
     def as_matrix(self, *, out=None):
         """Homogeneous matrices ``[[c, -s, tx], [s, c, ty], [0, 0, 1]]``, (..., 3, 3)."""
