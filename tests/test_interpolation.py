@@ -437,3 +437,17 @@ def test_no_warnings_on_ordinary_input(keyframes):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         rk.RotationSpline(times, keys)(times)
+
+
+def test_versinc2_rate_against_mpmath():
+    """The angular-acceleration coefficient (2(1 - cos x) - x sin x)/x^4, to a few ulp."""
+    import mpmath
+
+    from rigidkit.kernels.so3_rates import versinc2_rate
+
+    xs = np.concatenate([np.geomspace(1e-9, 1.0, 40), np.linspace(1.0, 6.2, 40)])
+    with mpmath.workdps(80):  # the closed form cancels ~x^-2 digits near 0
+        for x in xs:
+            xm = mpmath.mpf(float(x))
+            ref = float((2 * (1 - mpmath.cos(xm)) - xm * mpmath.sin(xm)) / xm**4)
+            assert abs(versinc2_rate(float(x)) - ref) <= 8 * np.finfo(float).eps * ref, x
