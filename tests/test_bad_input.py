@@ -302,3 +302,209 @@ def test_every_tangent_check_rejects_non_finite(module, dof, bad):
     xi[1, 2, 0] = bad
     with pytest.raises(rk.NonFiniteError, match=r"\(1, 2\)"):
         getattr(rk, module).exp(xi)
+
+
+# -- the batch index as an attribute (err.index), for programs such as the CLI ---------
+def _rotations_with_one_reflection():
+    m = _batch_with_bad(np.eye(3), np.diag([1.0, 1.0, -1.0]))
+    return m
+
+
+def _homogeneous_with(block=None, bottom=None, n=4):
+    m = _batch_with_bad(np.eye(n), np.eye(n))
+    if block is not None:
+        m[1, 2, : n - 1, : n - 1] = block
+    if bottom is not None:
+        m[1, 2, n - 1] = bottom
+    return m
+
+
+def _singular_affine_block():
+    A = _batch_with_bad(np.eye(3), np.eye(3))
+    A[1, 2] = [[1.0, 2.0, 3.0], [2.0, 4.0, 6.0], [0.0, 0.0, 1.0]]  # rank 2
+    return A
+
+
+def _projective_point_at_infinity():
+    H = np.eye(4)
+    H[3, 2] = 1.0  # w' = z + 1
+    p = _batch_with_bad(np.zeros(3), [0.0, 0.0, -1.0])
+    return lambda: rk.Projective(H) @ p
+
+
+INDEXED_ERRORS = {
+    "quaternion zero": (
+        rk.ZeroNormError,
+        lambda: rk.Rotation.from_quat(_batch_with_bad([1.0, 0, 0, 0], [0.0] * 4)),
+    ),
+    "quaternion nan": (
+        rk.NonFiniteError,
+        lambda: rk.Rotation.from_quat(_batch_with_bad([1.0, 0, 0, 0], [np.nan, 0, 0, 0])),
+    ),
+    "functional matrix_from_quat zero": (
+        rk.ZeroNormError,
+        lambda: C.matrix_from_quat(_batch_with_bad([1.0, 0, 0, 0], [0.0] * 4)),
+    ),
+    "functional quat_apply nan": (
+        rk.NonFiniteError,
+        lambda: C.quat_apply(_batch_with_bad([1.0, 0, 0, 0], [np.nan] * 4), np.ones(3)),
+    ),
+    "rotation matrix reflection": (
+        rk.NotARotationError,
+        lambda: rk.Rotation.from_matrix(_rotations_with_one_reflection()),
+    ),
+    "so3.adjoint of a reflection": (
+        rk.NotARotationError,
+        lambda: rk.so3.adjoint(_rotations_with_one_reflection()),
+    ),
+    "SE(3) bottom row": (
+        rk.NotARigidTransformError,
+        lambda: rk.Transform.from_matrix(_homogeneous_with(bottom=[0.0, 0.1, 0.0, 1.0])),
+    ),
+    "SE(3) rotation block": (
+        rk.NotARigidTransformError,
+        lambda: rk.se3.adjoint(_homogeneous_with(block=2.0 * np.eye(3))),
+    ),
+    "SE(2) bottom row": (
+        rk.NotARigidTransformError,
+        lambda: rk.Transform2D.from_matrix(_homogeneous_with(bottom=[0.1, 0.0, 1.0], n=3)),
+    ),
+    "SO(2) scaling": (
+        rk.NotARotationError,
+        lambda: rk.Rotation2D.from_matrix(_batch_with_bad(np.eye(2), 2.0 * np.eye(2))),
+    ),
+    "SO(2) zero pair": (
+        rk.ZeroNormError,
+        lambda: rk.Rotation2D(_batch_with_bad([1.0, 0.0], [0.0, 0.0])),
+    ),
+    "Sim(3) shear": (
+        rk.NotASimilarityError,
+        lambda: rk.Similarity.from_matrix(
+            _homogeneous_with(block=np.diag([1.0, 1.0, 2.0]))
+        ),
+    ),
+    "Sim(3) zero block": (
+        rk.NotASimilarityError,
+        lambda: rk.sim3.log(_homogeneous_with(block=np.zeros((3, 3)))),
+    ),
+    "Sim(3) scale": (
+        rk.NotASimilarityError,
+        lambda: rk.Similarity(scale=_batch_with_bad(1.0, -2.0)),
+    ),
+    "affine bottom row": (
+        rk.NotAffineError,
+        lambda: rk.Affine.from_matrix(_homogeneous_with(bottom=[0.0, 0.0, 0.5, 1.0])),
+    ),
+    "affine singular": (
+        rk.SingularMatrixError,
+        lambda: rk.Affine(matrix=_singular_affine_block()),
+    ),
+    "projective point at infinity": (
+        rk.PointAtInfinityError,
+        _projective_point_at_infinity(),
+    ),
+    "zero axis": (
+        rk.ZeroNormError,
+        lambda: rk.Rotation.from_axis_angle(_batch_with_bad([1.0, 0, 0], [0.0] * 3), 1.0),
+    ),
+    "zero quaternion inverse": (
+        rk.ZeroNormError,
+        lambda: rk.quaternion.inv(_batch_with_bad([1.0, 0, 0, 0], [0.0] * 4)),
+    ),
+    "non-finite twist": (
+        rk.NonFiniteError,
+        lambda: rk.se3.right_jacobian(_batch_with_bad(np.zeros(6), [np.nan] * 6)),
+    ),
+}
+
+
+@pytest.mark.parametrize("case", sorted(INDEXED_ERRORS))
+def test_errors_carry_the_batch_index(case):
+    """``err.index`` is the first bad batch index, the same the message names."""
+    exc, fn = INDEXED_ERRORS[case]
+    with pytest.raises(exc) as info:
+        fn()
+    assert info.value.index == (1, 2), str(info.value)
+    assert "(1, 2)" in str(info.value)
+
+
+def test_a_single_bad_input_has_the_empty_index():
+    with pytest.raises(rk.ZeroNormError) as info:
+        C.matrix_from_quat([0.0, 0.0, 0.0, 0.0])
+    assert info.value.index == ()
+    with pytest.raises(rk.NotARotationError) as info:
+        rk.so3.log(np.diag([1.0, 1.0, -1.0]))
+    assert info.value.index == ()
+
+
+def test_every_indexed_raise_passes_index():
+    """Statically: a ``raise`` whose message names the batch index passes ``index=``.
+
+    (Indexed errors are raised through ``rigidkit._validate.raise_where``, which
+    always does; this catches a message built by hand.)
+    """
+    import ast
+    from pathlib import Path
+
+    root = Path(rk.__file__).parent
+    missing = []
+    for path in sorted(root.rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if not (isinstance(node, ast.Raise) and isinstance(node.exc, ast.Call)):
+                continue
+            text = ast.unparse(node.exc)
+            names_index = "where_text" in text or "batch index" in text
+            if names_index and not any(k.arg == "index" for k in node.exc.keywords):
+                missing.append(f"{path.relative_to(root)}:{node.lineno}")
+    assert missing == []
+
+
+# -- functional conversions validate like the classes ----------------------------------
+def test_functional_conversions_normalise_the_quaternion():
+    q = np.array([[2.0, 0.0, 0.0, 0.0], [0.5, -1.0, 2.0, -3.0]])
+    np.testing.assert_array_equal(C.matrix_from_quat(q)[0], np.eye(3))
+    # scipy reads (x, y, z, w) and normalises, as Rotation.from_quat does
+    from scipy.spatial.transform import Rotation as SR
+
+    ref = SR.from_quat(q[:, [1, 2, 3, 0]])
+    np.testing.assert_allclose(C.matrix_from_quat(q), ref.as_matrix(), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(C.rotvec_from_quat(q), ref.as_rotvec(), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(C.mrp_from_quat(q), ref.as_mrp(), rtol=0, atol=1e-15)
+    v = np.array([1.0, 2.0, 3.0])
+    np.testing.assert_allclose(C.quat_apply(q, v), ref.apply(v), rtol=0, atol=1e-14)
+    axis, angle = C.axis_angle_from_quat(q)
+    np.testing.assert_allclose(axis * angle[..., None], ref.as_rotvec(), atol=1e-15)
+    np.testing.assert_allclose(
+        C.quat_angle_between(q[0], 5.0 * q[1]), ref[1].magnitude(), rtol=0, atol=1e-15
+    )
+    # The unchecked variants are the bare kernels: a scaled quaternion is not a rotation.
+    np.testing.assert_array_equal(C.matrix_from_quat_unchecked(q[0]), 4.0 * np.eye(3))
+
+
+def test_functional_poses_normalise_their_rotation():
+    pose = np.array([0.0, 0.0, 0.0, 2.0, 1.0, 2.0, 3.0])  # quaternion 2k: a half turn
+    M = rk.se3.matrix_from_pose(pose)
+    np.testing.assert_allclose(M[:3, :3], np.diag([-1.0, -1.0, 1.0]), atol=1e-15)
+    np.testing.assert_array_equal(M[:3, 3], [1.0, 2.0, 3.0])
+    np.testing.assert_allclose(rk.se3.twist_from_pose(pose), rk.se3.log(M), atol=1e-15)
+    T2 = rk.se2.matrix_from_pose([0.0, 3.0, 1.0, 2.0])  # (cos, sin) = 3 (0, 1): 90 deg
+    np.testing.assert_allclose(
+        T2, [[0.0, -1.0, 1.0], [1.0, 0.0, 2.0], [0, 0, 1]], atol=1e-15
+    )
+    with pytest.raises(rk.ZeroNormError):
+        rk.se3.matrix_from_pose(np.zeros(7))
+    with pytest.raises(rk.ZeroNormError):
+        rk.se2.matrix_from_pose(np.zeros(4))
+
+
+def test_functional_adjoints_are_new_validated_arrays(rng):
+    R = rk.Rotation.random(3, rng).as_matrix()
+    Ad = rk.so3.adjoint(R)
+    assert Ad is not R and not np.shares_memory(Ad, R)
+    np.testing.assert_allclose(Ad, R, rtol=0, atol=1e-15)
+    with pytest.raises(rk.NotARotationError):
+        rk.so3.adjoint(2.0 * R)
+    M = rk.Transform.random(3, rng).as_matrix()
+    M[1, 3, 0] = 0.5
+    with pytest.raises(rk.NotARigidTransformError, match="bottom row"):
+        rk.se3.adjoint(M)

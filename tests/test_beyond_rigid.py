@@ -93,7 +93,14 @@ def assert_inverse_close(got, M):
 
 
 def homog(X):
-    return rk.objects.projective.homogeneous_matrix(X)
+    """The 4x4 homogeneous matrix of any kind, ``[[R, 0], [0, 1]]`` for a rotation."""
+    M = np.asarray(X.as_matrix(), dtype=np.float64)
+    if M.shape[-1] == 4:
+        return M
+    out = np.zeros(M.shape[:-2] + (4, 4))
+    out[..., :3, :3] = M
+    out[..., 3, 3] = 1.0
+    return out
 
 
 # -- Sim(3): coefficients -------------------------------------------------------------
@@ -734,3 +741,57 @@ def test_sim3_functional_layer(rng):
     np.testing.assert_allclose(rk.sim3.log(M), xi, rtol=0, atol=1e-14 * 8)
     with pytest.raises(rk.NotASimilarityError):
         rk.sim3.log(np.diag([1.0, 2.0, 3.0, 1.0]))
+
+
+# -- the ladder of kinds (rigidkit.objects.ladder) ---------------------------------------
+def test_ladder_ranks_and_families():
+    from rigidkit.objects import ladder
+
+    ranks = [ladder.kind_of(x)[1:] for x in _one_of_each(np.random.default_rng(1))]
+    assert ranks == [("space", r) for r in range(5)]
+    assert ladder.kind_of(rk.Transform2D.identity())[1:] == ("plane", 1)
+    assert ladder.kind_of(np.eye(4)) is None
+    with pytest.raises(ValueError, match="already has rank"):
+        ladder.register(type("Impostor", (), {}), "space", 2)
+
+
+def test_ladder_homogeneous_matrix_of_a_rotation(rng):
+    from rigidkit.objects import ladder
+
+    R = rk.Rotation.random((2, 3), rng)
+    np.testing.assert_array_equal(ladder.homogeneous_matrix(R), homog(R))
+
+
+def test_families_do_not_mix(rng):
+    with pytest.raises(TypeError, match="family"):
+        rk.Rotation.random((), rng) @ rk.Rotation2D.random((), rng)
+    with pytest.raises(TypeError, match="family"):
+        rk.Transform2D.random((), rng) @ rk.Similarity.random((), rng)
+    with pytest.raises(TypeError):
+        rk.Transform2D.include(rk.Rotation.identity())
+
+
+def test_include_is_the_inclusion_map(rng):
+    R = rk.Rotation.random(4, rng)
+    T = rk.Transform.include(R)
+    assert type(T) is rk.Transform
+    np.testing.assert_allclose(T.as_matrix(), homog(R), rtol=0, atol=1e-15)
+    assert rk.Transform.include(T) is T
+    R2 = rk.Rotation2D.random(4, rng)
+    M2 = np.asarray(rk.Transform2D.include(R2).as_matrix())
+    np.testing.assert_array_equal(M2[..., :2, :2], R2.as_matrix())
+    np.testing.assert_array_equal(M2[..., :2, 2], 0.0)
+    with pytest.raises(TypeError):
+        rk.Rotation.include(T)  # a more general kind is not included
+    with pytest.raises(TypeError):
+        rk.Similarity.include(rk.Affine.identity())
+
+
+def test_a_subclass_keeps_its_place_on_the_ladder(rng):
+    class MyRotation(rk.Rotation):
+        __slots__ = ()
+
+    R = MyRotation._wrap(rk.Rotation.random(3, rng).as_quat())
+    T = rk.Transform.random(3, rng)
+    np.testing.assert_allclose((R @ T).as_matrix(), homog(R) @ homog(T), atol=1e-14)
+    np.testing.assert_allclose((T @ R).as_matrix(), homog(T) @ homog(R), atol=1e-14)
