@@ -7,10 +7,11 @@ batch. :class:`BatchedArray` implements, once, what depends only on that layout:
 ``shape``, ``dtype``, ``single``, ``len``, indexing, iteration, ``reshape``,
 ``concatenate``, pickling, identity equality and the batch half of ``repr``.
 
-It is deliberately only the container surface: group operations (``@``, ``apply``,
-``inv``, ``as_matrix``) stay in each class, written against its own attribute, so a
-single-element call pays nothing for this mixin. The group interface is
-:class:`rigidkit.group.LieGroup`, a separate base.
+It is deliberately only the container surface. ``@``, ``compose``, ``include`` and
+``identity`` are defined once for every kind of transform in
+:class:`rigidkit.objects.group.Group` (which reads the stored array through
+``_data``); ``apply``, ``inv`` and ``as_matrix`` stay in each class, written against
+its own attribute, so a single-element call pays nothing for the bases.
 """
 
 from __future__ import annotations

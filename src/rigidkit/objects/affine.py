@@ -62,6 +62,7 @@ class Affine(BatchedArray, Group, family="space", rank=3):
     __slots__ = ("_data",)
     _trail = (3, 4)
     _identity = np.eye(3, 4)  # [I | 0]
+    _compose_kernel = _k.affine_compose
 
     def __init__(self, matrix=None, translation=None, *, rtol=None):
         A = (
@@ -170,10 +171,6 @@ class Affine(BatchedArray, Group, family="space", rank=3):
         return Projective.include(self)
 
     # -- operations --------------------------------------------------------------------
-    def compose(self, other):
-        """``self @ other`` (``other`` applied first) for another ``Affine``."""
-        return Affine._wrap(_k.affine_compose(self._data, other._data))
-
     def apply(self, points):
         """``A p + t`` for points of shape (..., 3), broadcasting with the batch shape."""
         return _k.affine_apply(self._data, as_array(points, (3,), "points"))

@@ -39,10 +39,10 @@ class Group(ABC):
     :class:`~rigidkit.objects._batch.BatchedArray` too). A subclass places itself
     on the ladder of kinds (:mod:`rigidkit.objects.ladder`) with class keywords,
     ``class Transform(BatchedArray, LieGroup, family="space", rank=1)``, stores its
-    identity element in ``_identity``, and implements ``compose`` (with another
-    element of its own kind), ``apply`` (to points), ``inv`` and, when a lower kind
-    exists, the class method ``_include`` (an element of a lower kind of its
-    family, as this kind). Then
+    identity element in ``_identity`` and the kernel composing two of its stored
+    arrays in ``_compose_kernel``, and implements ``apply`` (to points), ``inv``
+    and, when a lower kind exists, the class method ``_include`` (an element of a
+    lower kind of its family, as this kind). Then
 
     - ``a @ b`` of one kind is ``a.compose(b)``;
     - ``a @ b`` of two kinds of one family is composed in the more general kind
@@ -61,12 +61,31 @@ class Group(ABC):
         if family is not None:
             ladder.register(cls, family, rank)
 
+    # The kernel that composes two stored arrays of this kind; each kind sets it.
+    _compose_kernel = None
+
     def __matmul__(self, other):
-        if type(other) is type(self):  # the common case, without looking up kinds
-            return self.compose(other)
+        if type(other) is type(self):  # the common case: one frame from ``@`` to the kernel
+            return self._wrap(self._compose_kernel(self._data, other._data))
         if isinstance(other, Group):
             return ladder.compose(self, other)
         return self.apply(other)
+
+    def compose(self, other, *, out=None):
+        """``self @ other`` (``other`` applied first), for ``other`` of the same kind.
+
+        ``out``: a C-contiguous NumPy array of the stored shape (``batch`` plus the
+        shape of one stored element: quaternions (..., 4) for a ``Rotation``, poses
+        (..., 7) for a ``Transform``, ...) that receives the result, which then
+        wraps it (no copy); reusing one saves the page faults of a fresh large
+        output.
+
+        >>> import rigidkit as rk
+        >>> R = rk.Rotation.from_rotvec([0.0, 0.0, 0.5])
+        >>> R.compose(R).as_rotvec()
+        array([0., 0., 1.])
+        """
+        return self._wrap(self._compose_kernel(self._data, other._data, out=out))
 
     def __rmatmul__(self, other):
         name = type(self).__name__
@@ -105,9 +124,6 @@ class Group(ABC):
         Each kind stores its identity element as the class attribute ``_identity``.
         """
         return cls._wrap(cls._filled(cls._identity, shape, dtype))
-
-    @abstractmethod
-    def compose(self, other): ...
 
     @abstractmethod
     def apply(self, points): ...

@@ -45,10 +45,13 @@ def kind_of(x):
     The kind is the registered class of ``x``, or of the nearest registered base
     class for a subclass of one.
     """
-    for cls in type(x).__mro__:
+    place = _KINDS.get(type(x))
+    if place is not None:  # the common case, a registered class itself
+        return type(x), place[0], place[1]
+    for cls in type(x).__mro__[1:]:
         place = _KINDS.get(cls)
         if place is not None:
-            return (cls, *place)
+            return cls, place[0], place[1]
     return None
 
 
@@ -73,8 +76,12 @@ def compose(a, b):
             f"cannot compose {type(a).__name__} with {type(b).__name__}: both must be "
             f"kinds of one family ({_family_names(family)})"
         )
-    kind = ka[0] if ka[2] >= kb[2] else kb[0]
-    return kind.include(a).compose(kind.include(b))
+    # Both are on one ladder (checked above): include the lower one into the other.
+    if ka[2] > kb[2]:
+        b = ka[0]._include(b)
+    elif ka[2] < kb[2]:
+        a = kb[0]._include(a)
+    return a._wrap(a._compose_kernel(a._data, b._data))
 
 
 def check_included(cls, x, what: str) -> None:

@@ -70,6 +70,7 @@ class Projective(BatchedArray, Group, family="space", rank=4):
     __slots__ = ("_data",)
     _trail = (4, 4)
     _identity = np.eye(4)
+    _compose_kernel = _k.projective_compose
 
     def __init__(self, matrix, *, rtol=None):
         H = as_float(as_array(matrix, (4, 4), "projective matrix"))
@@ -111,10 +112,6 @@ class Projective(BatchedArray, Group, family="space", rank=4):
         return self
 
     # -- operations ----------------------------------------------------------------------
-    def compose(self, other):
-        """``self @ other`` (``other`` applied first) for another ``Projective``."""
-        return Projective._wrap(_k.projective_compose(self._data, other._data))
-
     def inv(self, *, rtol=None):
         """Inverse transforms ``H^-1`` (adjugate; raises if ``H`` became singular)."""
         inv, ratio = _k.projective_inverse(self._data)

@@ -46,6 +46,7 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
     _storage = "_quat"
     _trail = (4,)
     _identity = (1.0, 0.0, 0.0, 0.0)
+    _compose_kernel = _conv.quat_multiply
     dof, matrix_size, point_dim = 3, 3, 3
 
     def __init__(self, quat, *, _normalized=False):
@@ -189,15 +190,8 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
         return self.as_axis_angle()[0]
 
     # -- group operations ----------------------------------------------------------
-    # ``R1 @ R2`` composes (``R2`` first) and ``R @ v`` rotates vectors: Group.__matmul__.
-    def compose(self, other, *, out=None):
-        """``self @ other`` (``other`` first), optionally into a quaternion buffer.
-
-        ``out``: a C-contiguous NumPy array of shape ``batch + (4,)`` that receives
-        the quaternions; the result wraps it (no copy).
-        """
-        return Rotation._wrap(_conv.quat_multiply(self._quat, other._quat, out=out))
-
+    # ``R1 @ R2`` composes (``R2`` first), ``R @ v`` rotates vectors and ``compose``
+    # takes an ``out=`` buffer: Group, with the Hamilton product as _compose_kernel.
     def apply(self, vectors, *, out=None):
         """Rotate vectors, shape (..., 3) broadcasting with the rotation's shape."""
         v = as_array(vectors, (3,), "vectors")

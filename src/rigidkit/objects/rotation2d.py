@@ -53,6 +53,7 @@ class Rotation2D(BatchedArray, LieGroup, family="plane", rank=0):
     __slots__ = ("_data",)
     _trail = (2,)
     _identity = (1.0, 0.0)  # (cos 0, sin 0)
+    _compose_kernel = _k.complex_multiply
     dof, matrix_size, point_dim = 1, 2, 2
 
     def __init__(self, cos_sin):
@@ -164,11 +165,7 @@ class Rotation2D(BatchedArray, LieGroup, family="plane", rank=0):
         return _k.adjoint_from_complex(self._data)
 
     # -- group operations ----------------------------------------------------------
-    # ``R1 @ R2`` composes (``R2`` first) and ``R @ p`` rotates points: Group.__matmul__.
-    def compose(self, other, *, out=None):
-        """``self @ other`` (``other`` first), optionally into a ``(cos, sin)`` buffer."""
-        return Rotation2D._wrap(_k.complex_multiply(self._data, other._data, out=out))
-
+    # ``R1 @ R2`` composes (``R2`` first), ``R @ p`` rotates points: Group.
     def apply(self, points, *, out=None):
         """Rotate points, shape (..., 2) broadcasting with the rotation's shape."""
         p = as_array(points, (2,), "points")

@@ -65,6 +65,7 @@ class Similarity(BatchedArray, LieGroup, family="space", rank=2):
     __slots__ = ("_data",)
     _trail = (8,)
     _identity = (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)  # (q, t, s)
+    _compose_kernel = _k.sim3_compose
     dof, matrix_size, point_dim = 7, 4, 3
 
     def __init__(self, scale=None, rotation=None, translation=None):
@@ -209,10 +210,6 @@ class Similarity(BatchedArray, LieGroup, family="space", rank=2):
         return _k.sim3_adjoint(self._data)
 
     # -- group operations ---------------------------------------------------------------
-    def compose(self, other):
-        """``self @ other`` (``other`` applied first) for another ``Similarity``."""
-        return Similarity._wrap(_k.sim3_compose(self._data, other._data))
-
     def apply(self, points):
         """``s R p + t`` for points of shape (..., 3), broadcasting with the batch shape."""
         return _k.sim3_apply(self._data, as_array(points, (3,), "points"))

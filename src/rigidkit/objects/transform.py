@@ -62,6 +62,7 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
     _storage = "_pose"
     _trail = (7,)
     _identity = (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)  # (w, x, y, z, tx, ty, tz)
+    _compose_kernel = _k.pose_compose
     dof, matrix_size, point_dim = 6, 4, 3
 
     def __init__(self, rotation=None, translation=None):
@@ -154,20 +155,12 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
         return self._pose[..., 4:]
 
     # -- group operations --------------------------------------------------------------
-    # ``T1 @ T2`` composes (``T2`` first) and ``T @ p`` moves points: Group.__matmul__.
+    # ``T1 @ T2`` composes (``T2`` first), ``T @ p`` moves points and ``compose`` takes
+    # an ``out=`` buffer of poses: Group, with _compose_kernel.
     # A Rotation on either side is the transform with zero translation (_include).
     @classmethod
     def _include(cls, x):
         return cls(rotation=x)
-
-    def compose(self, other, *, out=None):
-        """``self @ other`` (``other`` first), optionally into a pose buffer.
-
-        ``out``: a C-contiguous NumPy array of shape ``batch + (7,)`` that receives
-        the poses ``(w, x, y, z, tx, ty, tz)``; reusing one saves the page faults of
-        a fresh large output. The result wraps ``out`` (no copy).
-        """
-        return Transform._wrap(_k.pose_compose(self._pose, other._pose, out=out))
 
     def apply(self, points, *, out=None):
         """Move points: ``R p + t``, shape (..., 3) broadcasting with the batch shape."""

@@ -57,6 +57,7 @@ class Transform2D(BatchedArray, LieGroup, family="plane", rank=1):
     __slots__ = ("_data",)
     _trail = (4,)
     _identity = (1.0, 0.0, 0.0, 0.0)  # (cos 0, sin 0, tx, ty)
+    _compose_kernel = _k.pose_multiply
     dof, matrix_size, point_dim = 3, 3, 2
 
     def __init__(self, rotation=None, translation=None):
@@ -147,10 +148,6 @@ class Transform2D(BatchedArray, LieGroup, family="plane", rank=1):
     # -- group operations ----------------------------------------------------------
     # ``T1 @ T2`` composes (``T2`` first; either may be a Rotation2D) and ``T @ p``
     # maps points: Group.__matmul__.
-    def compose(self, other, *, out=None):
-        """``self @ other`` (``other`` first), optionally into a pose buffer."""
-        return Transform2D._wrap(_k.pose_multiply(self._data, other._data, out=out))
-
     @classmethod
     def _include(cls, x):
         return cls(rotation=x)
