@@ -38,7 +38,7 @@ import math
 
 import numpy as np
 
-from .._engine.namespace import is_numpy, namespace_of
+from .._engine.namespace import namespace_of
 from .._validate import (
     all_true,
     as_array,
@@ -189,17 +189,18 @@ def quat_angle_between(quat1, quat2):
 
 
 def quat_wxyz_from_xyzw(q):
-    """Reorder scalar-last ``(x, y, z, w)`` to scalar-first ``(w, x, y, z)``."""
-    xp = namespace_of(q)
-    q = np.asarray(q) if is_numpy(xp) else q
-    return xp.concat([q[..., 3:], q[..., :3]], axis=-1)
+    """Reorder scalar-last ``(x, y, z, w)`` to scalar-first ``(w, x, y, z)``, (..., 4).
+
+    Only the order changes (no normalisation): any quaternion, scipy's or ROS's.
+    """
+    q = as_array(q, (4,), "quaternion (x, y, z, w)")
+    return namespace_of(q).concat([q[..., 3:], q[..., :3]], axis=-1)
 
 
 def quat_xyzw_from_wxyz(q):
-    """Reorder scalar-first ``(w, x, y, z)`` to scalar-last ``(x, y, z, w)``."""
-    xp = namespace_of(q)
-    q = np.asarray(q) if is_numpy(xp) else q
-    return xp.concat([q[..., 1:], q[..., :1]], axis=-1)
+    """Reorder scalar-first ``(w, x, y, z)`` to scalar-last ``(x, y, z, w)``, (..., 4)."""
+    q = as_array(q, (4,), "quaternion (w, x, y, z)")
+    return namespace_of(q).concat([q[..., 1:], q[..., :1]], axis=-1)
 
 
 def quat_from_matrix(matrix, *, atol=None, orthonormalize=False):
@@ -237,9 +238,13 @@ def quat_from_matrix(matrix, *, atol=None, orthonormalize=False):
 
 
 def nearest_rotation_matrix(matrix):
-    """The rotation closest in Frobenius norm: ``U diag(1, 1, det(U V^T)) V^T``."""
-    xp = namespace_of(matrix)
-    m = np.asarray(matrix) if is_numpy(xp) else matrix
+    """The rotation closest in Frobenius norm: ``U diag(1, 1, det(U V^T)) V^T``.
+
+    ``matrix`` (..., 3, 3) must be finite (checked before the SVD, which can hang
+    on infinities); a rank-deficient matrix gets one of its nearest rotations.
+    """
+    m = finite_array(matrix, (3, 3), "matrix")
+    xp = namespace_of(m)
     u, _, vt = xp.linalg.svd(m)
     d = xp.linalg.det(u @ vt)
     ones = xp.ones_like(d)
