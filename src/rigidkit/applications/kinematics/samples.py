@@ -54,7 +54,7 @@ def _times(times, n, like, fn):
     return h
 
 
-def _combine(d, h, xp):
+def _combine(d, h, xp, second=None, before_last=None):
     """Velocities at the samples from the steps' means ``d`` (..., N-1, W), steps ``h``."""
     if d.shape[-2] == 1:
         return xp.concat([d, d], axis=-2)
@@ -65,9 +65,11 @@ def _combine(d, h, xp):
     dp = d[..., 1:, :]
     inner = (h1 * dp + h2 * dm) / (h1 + h2)
     a1, a2 = h[..., :1, :], h[..., 1:2, :]
-    first = ((2.0 * a1 + a2) * d[..., :1, :] - a1 * d[..., 1:2, :]) / (a1 + a2)
+    d2 = d[..., 1:2, :] if second is None else second
+    first = ((2.0 * a1 + a2) * d[..., :1, :] - a1 * d2) / (a1 + a2)
     b1, b2 = h[..., -1:, :], h[..., -2:-1, :]
-    last = ((2.0 * b1 + b2) * d[..., -1:, :] - b1 * d[..., -2:-1, :]) / (b1 + b2)
+    dp = d[..., -2:-1, :] if before_last is None else before_last
+    last = ((2.0 * b1 + b2) * d[..., -1:, :] - b1 * dp) / (b1 + b2)
     return xp.concat([first, inner, last], axis=-2)
 
 
@@ -127,7 +129,14 @@ def angular_velocity_from_samples(rotations, times, *, frame=None):
         else _conv.quat_multiply(b, _conv.quat_conjugate(a))
     )
     d = _conv.rotvec_from_quat(rel) / h[..., None]
-    return _combine(d, h, namespace_of(d))
+    if not body or n < 3:
+        return _combine(d, h, namespace_of(d))
+    # A body increment is in the axes of its own step; the one-sided ends combine
+    # two steps, so the second is turned into the axes of the end sample (then
+    # omega_world = R omega_body holds at every sample, as in the world frame).
+    second = _conv.quat_apply(rel[..., :1, :], d[..., 1:2, :])
+    before_last = _conv.quat_apply(_conv.quat_conjugate(rel[..., -1:, :]), d[..., -2:-1, :])
+    return _combine(d, h, namespace_of(d), second, before_last)
 
 
 def twist_from_samples(transforms, times, *, frame=None):
@@ -176,4 +185,15 @@ def twist_from_samples(transforms, times, *, frame=None):
         else _se3.pose_compose(b, _se3.pose_inv(a))
     )
     d = _se3.twist_from_pose(rel) / h[..., None]
-    return _combine(d, h, namespace_of(d))
+    if not body or n < 3:
+        return _combine(d, h, namespace_of(d))
+    # As for rotations: the second step's twist in the axes of the end sample.
+    second = _adjoint_apply(rel[..., :1, :], d[..., 1:2, :])
+    before_last = _adjoint_apply(_se3.pose_inv(rel[..., -1:, :]), d[..., -2:-1, :])
+    return _combine(d, h, namespace_of(d), second, before_last)
+
+
+def _adjoint_apply(pose, twist):
+    """``Ad_T V`` for poses (..., 7) and twists (..., 6)."""
+    Ad = _se3.adjoint_from_pose(pose)
+    return (Ad @ twist[..., None])[..., 0]

@@ -1,0 +1,308 @@
+"""Integration of angular velocity and twists, and velocities from samples (issue 8 §4, §6).
+
+References: closed-form motions (``R(t) = exp(hat(r(t)))`` with the body rate
+``J_r(r) r'`` from the SO(3) right Jacobian), scipy's Rotation (a step-by-step
+loop) and RotationSpline (whose rates are body-frame), scipy.linalg.expm for
+SE(3), and the measured convergence orders.
+"""
+
+import numpy as np
+import pytest
+import scipy.linalg as sl
+from scipy.spatial.transform import Rotation as SciRot
+from scipy.spatial.transform import RotationSpline
+
+import rigidkit as rk
+from rigidkit.applications.kinematics import _scan
+
+K = rk.kinematics
+
+
+def angle(a, b):
+    """Rotation angle between two rigidkit Rotations (float64 NumPy)."""
+    return np.asarray(rk.conversions.quat_angle_between(a.as_quat(), b.as_quat()))
+
+
+def r_of(t):
+    return np.stack(
+        [0.8 * np.sin(1.3 * t), 0.5 * np.cos(0.7 * t) - 0.5, 0.6 * np.sin(2.1 * t + 0.3)],
+        -1,
+    )
+
+
+def r_dot(t):
+    return np.stack(
+        [1.04 * np.cos(1.3 * t), -0.35 * np.sin(0.7 * t), 1.26 * np.cos(2.1 * t + 0.3)], -1
+    )
+
+
+def sampled(t, frame):
+    """Orientations R(t) = exp(hat(r(t))) and their angular velocity in ``frame``."""
+    R = rk.Rotation.from_rotvec(r_of(t))
+    wb = np.einsum("...ij,...j->...i", rk.so3.right_jacobian(r_of(t)), r_dot(t))
+    return R, (wb if frame == "body" else R.apply(wb))
+
+
+def test_constant_rate_reproduces_the_exponential_over_1e5_steps():
+    w = np.array([0.3, -0.2, 0.5])
+    N, dt = 100_000, 1e-3
+    ref = rk.Rotation.from_rotvec(w * N * dt)
+    for method in ("exact", "midpoint", "rk4"):
+        for frame in ("body", "world"):
+            traj = K.integrate_angular_velocity(
+                rk.Rotation.identity(), np.tile(w, (N, 1)), dt, frame=frame, method=method
+            )
+            assert traj.shape == (N + 1,)
+            assert angle(traj[-1], ref) < 1e-12
+            norms = np.linalg.norm(traj.as_quat(), axis=-1)
+            assert np.abs(norms - 1.0).max() < 1e-15 * 4
+
+
+@pytest.mark.parametrize("frame", ["body", "world"])
+def test_convergence_orders(frame):
+    """Measured orders on a smooth non-commuting rate: 1 (ZOH), 2, 4."""
+    T = 2.0
+    expected = {"exact": 1.0, "midpoint": 2.0, "rk4": 4.0}
+    for method, order in expected.items():
+        errs = []
+        for N in (100, 200, 400, 800):
+            t = np.linspace(0.0, T, N + 1)
+            R, w = sampled(t, frame)
+            traj = K.integrate_angular_velocity(
+                R[0], w[:-1], T / N, frame=frame, method=method
+            )
+            errs.append(float(angle(traj[-1], R[-1])))
+        measured = np.log2(np.array(errs[:-1]) / np.array(errs[1:]))
+        # pre-asymptotic at the coarsest steps, approaching the order
+        assert abs(measured[-1] - order) < 0.08, (method, measured)
+        assert np.all(np.abs(measured - order) < 0.25), (method, measured)
+
+
+def test_non_uniform_steps_keep_the_order():
+    T = 2.0
+    errs = []
+    for N in (100, 200, 400):
+        u = np.linspace(0.0, 1.0, N + 1)
+        t = T * (u + 0.15 * np.sin(np.pi * u) ** 2 * np.sign(np.cos(3 * u)) / np.pi / 3)
+        t = np.sort(t)
+        R, w = sampled(t, "body")
+        traj = K.integrate_angular_velocity(
+            R[0], w[:-1], np.diff(t), frame="body", method="rk4"
+        )
+        errs.append(float(angle(traj[-1], R[-1])))
+        # every intermediate orientation is close too
+        assert angle(traj, R).max() < 50 * errs[-1] + 1e-13
+    measured = np.log2(np.array(errs[:-1]) / np.array(errs[1:]))
+    assert np.all(measured > 3.7), measured
+
+
+def test_exact_method_equals_a_scipy_rotation_loop(rng):
+    w = rng.standard_normal((200, 3))
+    dt = 0.01
+    R = SciRot.identity()
+    body = [R]
+    for k in range(200):
+        R = R * SciRot.from_rotvec(w[k] * dt)
+        body.append(R)
+    ref = np.stack([r.as_quat(scalar_first=True) for r in body])
+    traj = K.integrate_angular_velocity(rk.Rotation.identity(), w, dt, frame="body")
+    assert angle(traj, rk.Rotation.from_quat(ref)).max() < 1e-13
+    # world frame: left multiplication
+    R = SciRot.identity()
+    for k in range(200):
+        R = SciRot.from_rotvec(w[k] * dt) * R
+    trw = K.integrate_angular_velocity(np.eye(3), w, dt, frame="world")
+    np.testing.assert_allclose(trw[-1], R.as_matrix(), atol=1e-13)
+    assert trw.shape == (201, 3, 3)
+
+
+def test_batched_trajectories_and_both_scan_bindings(rng, monkeypatch):
+    """Many trajectories at once; the numba scan and the prefix product agree."""
+    w = rng.standard_normal((3, 4, 500, 3))
+    R0 = rk.Rotation.random((4,), rng=2)  # broadcasts against (3, 4)
+    dt = rng.uniform(0.001, 0.01, 500)
+    for method in ("exact", "rk4"):
+        a = K.integrate_angular_velocity(R0, w, dt, frame="body", method=method)
+        assert a.shape == (3, 4, 501)
+        monkeypatch.setattr(_scan, "COMPILE_MIN", 10**12)  # force the prefix product
+        b = K.integrate_angular_velocity(R0, w, dt, frame="body", method=method)
+        monkeypatch.undo()
+        assert angle(a, b).max() < 1e-13
+        one = K.integrate_angular_velocity(R0[2], w[1, 2], dt, frame="body", method=method)
+        assert angle(a[1, 2], one).max() < 1e-14
+
+
+def test_float32_and_torch_jax_paths(rng, torch, jnp):
+    w = rng.standard_normal((300, 3))
+    ref = K.integrate_angular_velocity(
+        rk.Rotation.identity(), w, 0.01, frame="body", method="rk4"
+    )
+    w32 = w.astype(np.float32)
+    R0_32 = rk.Rotation.identity(dtype=np.float32)
+    t32 = K.integrate_angular_velocity(R0_32, w32, 0.01, frame="body", method="rk4")
+    assert t32.dtype == np.float32 and angle(t32, ref).max() < 1e-4
+    wt = torch.tensor(w, requires_grad=True)
+    R0 = rk.Rotation.from_quat(torch.tensor([1.0, 0.0, 0.0, 0.0], dtype=torch.float64))
+    tt = K.integrate_angular_velocity(R0, wt, 0.01, frame="body", method="rk4")
+    assert isinstance(tt.as_quat(), torch.Tensor)
+    np.testing.assert_allclose(
+        angle(rk.Rotation.from_quat(tt.as_quat().detach().numpy()), ref).max(),
+        0,
+        atol=1e-12,
+    )
+    tt.as_quat()[-1, 1].backward()
+    assert torch.isfinite(wt.grad).all() and float(wt.grad.abs().sum()) > 0
+    tj = K.integrate_angular_velocity(
+        rk.Rotation.from_quat(jnp.asarray([1.0, 0, 0, 0])),
+        jnp.asarray(w),
+        0.01,
+        frame="world",
+    )
+    refw = K.integrate_angular_velocity(rk.Rotation.identity(), w, 0.01, frame="world")
+    assert angle(rk.Rotation.from_quat(np.asarray(tj.as_quat())), refw).max() < 1e-12
+
+
+def test_integrate_twist_dead_reckoning(rng):
+    V = np.array([1.0, 0.2, -0.1, 0.1, -0.3, 0.5])
+    N, dt = 2000, 1e-3
+    ref = sl.expm(
+        np.block([[rk.so3.hat(V[3:]), V[:3, None]], [np.zeros((1, 4))]]) * (N * dt)
+    )
+    T0 = rk.Transform.random(rng=3)
+    for method in ("exact", "midpoint", "rk4"):
+        tb = K.integrate_twist(T0, np.tile(V, (N, 1)), dt, frame="body", method=method)
+        np.testing.assert_allclose(tb[-1].as_matrix(), T0.as_matrix() @ ref, atol=1e-11)
+        tw = K.integrate_twist(
+            T0.as_matrix(), np.tile(V, (N, 1)), dt, frame="world", method=method
+        )
+        np.testing.assert_allclose(tw[-1], ref @ T0.as_matrix(), atol=1e-11)
+    # orders on a varying twist: T(t) = exp(X(t)) with a known body twist from samples
+    errs = {m: [] for m in ("exact", "midpoint", "rk4")}
+    for N in (200, 400, 800):
+        t = np.linspace(0.0, 1.0, N + 1)
+        X = np.stack(
+            [
+                np.sin(t),
+                0.5 * t * t,
+                np.cos(2 * t) - 1,
+                0.4 * np.sin(2 * t),
+                0.3 * t,
+                -0.5 * t * t,
+            ],
+            -1,
+        )
+        T = rk.Transform.exp(X)
+        Vb = K.twist_from_samples(T, t, frame="body")  # 2nd-order, not the reference
+        Vexact = np.stack([_body_twist(X[k], _xdot(t[k])) for k in range(N + 1)])
+        assert np.abs(Vb - Vexact).max() < 30.0 / N**2
+        for m in errs:
+            tr = K.integrate_twist(T[0], Vexact[:-1], 1.0 / N, frame="body", method=m)
+            errs[m].append(float(np.abs(tr[-1].as_matrix() - T[-1].as_matrix()).max()))
+    for m, order in (("exact", 1), ("midpoint", 2), ("rk4", 4)):
+        measured = np.log2(np.array(errs[m][:-1]) / np.array(errs[m][1:]))
+        assert np.all(np.abs(measured - order) < 0.2), (m, measured)
+
+
+def _xdot(t):
+    return np.array([np.cos(t), t, -2 * np.sin(2 * t), 0.8 * np.cos(2 * t), 0.3, -t])
+
+
+def _body_twist(X, Xd):
+    """Body twist of exp(X(t)): vee(T^-1 T'), from expm of the block matrix (Van Loan)."""
+    A = np.block([[rk.so3.hat(X[3:]), X[:3, None]], [np.zeros((1, 4))]])
+    B = np.block([[rk.so3.hat(Xd[3:]), Xd[:3, None]], [np.zeros((1, 4))]])
+    big = sl.expm(np.block([[A, B], [np.zeros((4, 4)), A]]))
+    T, T_dot = big[:4, :4], big[:4, 4:]
+    return rk.se3.vee(np.linalg.inv(T) @ T_dot)
+
+
+def test_integration_errors():
+    w = np.ones((3, 3))
+    with pytest.raises(rk.FrameError):
+        K.integrate_angular_velocity(rk.Rotation.identity(), w, 0.1)
+    with pytest.raises(ValueError, match="method"):
+        K.integrate_angular_velocity(
+            rk.Rotation.identity(), w, 0.1, frame="body", method="euler"
+        )
+    with pytest.raises(rk.DegenerateInputError, match="at least 4"):
+        K.integrate_angular_velocity(
+            rk.Rotation.identity(), w, 0.1, frame="body", method="rk4"
+        )
+    with pytest.raises(rk.ShapeError):
+        K.integrate_angular_velocity(rk.Rotation.identity(), w, np.ones(5), frame="body")
+    with pytest.raises(rk.NonFiniteError):
+        K.integrate_angular_velocity(rk.Rotation.identity(), w * np.nan, 0.1, frame="body")
+
+
+def test_one_hour_at_1khz_runs(rng):
+    """3.6 M steps: runs and stays unit (its time is measured in the benchmark)."""
+    w = rng.standard_normal((3_600_000, 3)).astype(np.float64)
+    traj = K.integrate_angular_velocity(rk.Rotation.identity(), w, 1e-3, frame="body")
+    n = np.linalg.norm(traj.as_quat()[-1000:], axis=-1)
+    assert np.abs(n - 1).max() < 1e-15 * 4
+
+
+# -- velocities from samples -----------------------------------------------------------
+
+
+@pytest.mark.parametrize("frame", ["body", "world"])
+def test_constant_velocity_is_exact_with_non_uniform_times(frame, rng):
+    w = np.array([0.4, -1.1, 0.7])
+    R0 = rk.Rotation.random(rng=1)
+    t = np.cumsum(rng.uniform(0.01, 0.3, 12))
+    step = rk.Rotation.from_rotvec(np.outer(t, w))
+    R = R0 @ step if frame == "body" else step @ R0
+    np.testing.assert_allclose(
+        K.angular_velocity_from_samples(R, t, frame=frame), np.tile(w, (12, 1)), atol=1e-9
+    )
+    V = rng.standard_normal(6)
+    T0 = rk.Transform.random(rng=2)
+    E = rk.Transform.exp(np.outer(t, V))
+    T = T0 @ E if frame == "body" else E @ T0
+    np.testing.assert_allclose(
+        K.twist_from_samples(T, t, frame=frame), np.tile(V, (12, 1)), atol=1e-9
+    )
+
+
+def test_samples_agree_with_scipy_rotation_spline():
+    """Body rates: scipy's RotationSpline(t, 1) is the body angular velocity of its
+    C2 interpolant (4th order in the interior, natural ends). Our second-order
+    differences approach it at the rate h^2."""
+    gaps = []
+    for n in (301, 601):
+        t = np.linspace(0.0, 3.0, n)
+        R, wb = sampled(t, "body")
+        spline = RotationSpline(t, SciRot.from_quat(R.as_quat(), scalar_first=True))
+        ours = K.angular_velocity_from_samples(R, t, frame="body")
+        theirs = spline(t, 1)
+        inner = slice(n // 20, n - n // 20)  # away from the spline's natural ends
+        assert np.abs(theirs[inner] - wb[inner]).max() < 1e-7
+        gaps.append(np.abs(ours[inner] - theirs[inner]).max())
+        ww = K.angular_velocity_from_samples(R.as_matrix(), t, frame="world")
+        np.testing.assert_allclose(ww, R.apply(ours), atol=1e-10)
+    assert gaps[1] < 1e-4
+    assert 3.6 < gaps[0] / gaps[1] < 4.4, gaps
+
+
+def test_samples_second_order_and_errors():
+    errs = []
+    for N in (50, 100, 200):
+        t = np.linspace(0.0, 2.0, N + 1) ** 1.2  # non-uniform
+        R, wb = sampled(t, "body")
+        errs.append(np.abs(K.angular_velocity_from_samples(R, t, frame="body") - wb).max())
+    measured = np.log2(np.array(errs[:-1]) / np.array(errs[1:]))
+    assert np.all(measured > 1.8), measured
+    # poses: world and body twists related by the adjoint at every sample, ends too
+    t = np.linspace(0.0, 1.0, 40) ** 1.3
+    X = np.stack([np.sin(t), t * t, np.cos(t), 0.5 * t, np.sin(2 * t), -t], -1)
+    T = rk.Transform.exp(X)
+    Vb = K.twist_from_samples(T, t, frame="body")
+    Vw = K.twist_from_samples(T.as_matrix(), t, frame="world")
+    np.testing.assert_allclose(Vw, (T.adjoint() @ Vb[..., None])[..., 0], atol=1e-10)
+    R = rk.Rotation.random((3,), rng=1)
+    with pytest.raises(rk.DegenerateInputError):
+        K.angular_velocity_from_samples(R, [0.0, 1.0, 1.0], frame="body")
+    with pytest.raises(rk.ShapeError):
+        K.angular_velocity_from_samples(R, [0.0, 1.0], frame="body")
+    with pytest.raises(rk.DegenerateInputError):
+        K.angular_velocity_from_samples(R[:1], [0.0], frame="body")
