@@ -81,7 +81,8 @@ def _grouped(xp, x, axes, trail):
     """``x`` (batch + trail) as (kept batch, K, trail): reduced axes merged into K."""
     nb = x.ndim - trail
     if len(axes) == nb:  # everything reduced (the default): no transpose
-        return xp.reshape(x, (math.prod(x.shape[:nb]),) + tuple(x.shape[nb:])), ()
+        shape = (math.prod(x.shape[:nb]),) + tuple(x.shape[nb:])
+        return (x.reshape(shape) if isinstance(x, np.ndarray) else xp.reshape(x, shape)), ()
     keep = [a for a in range(nb) if a not in axes]
     order = tuple(keep) + tuple(axes) + tuple(range(nb, x.ndim))
     y = _permute(xp, x, order)
@@ -120,7 +121,7 @@ def _chordal(xp, q, w):
         return _chordal_compiled(q, w)
     m = q.mT @ (q if w is None else q * w[..., None])  # (kept, 4, 4)
     _, vecs = xp.linalg.eigh(m)
-    return vecs[..., :, -1]
+    return _kq.quat_canonical(vecs[..., :, -1])
 
 
 def _chordal_loop(q, w, weighted, out):  # pragma: no cover - compiled by numba
@@ -199,12 +200,18 @@ def _chordal_loop(q, w, weighted, out):  # pragma: no cover - compiled by numba
         for i in range(1, 4):
             if a[i, i] > a[top, top]:
                 top = i
+        sign = 1.0  # quat_canonical's sign: the first nonzero component positive
         for i in range(4):
-            out[g, i] = v[i, top]
+            if v[i, top] != 0.0:
+                sign = 1.0 if v[i, top] > 0.0 else -1.0
+                break
+        for i in range(4):
+            out[g, i] = sign * v[i, top]
 
 
-#: Rotations per mean from which the NumPy path uses the compiled loop.
-GRAM_MIN = 256
+#: Rotations per mean from which the NumPy path uses the compiled loop (once it is
+#: compiled: the compile runs in the background, so no size waits for it).
+GRAM_MIN = 2
 _GRAM = None
 _GRAM_JOB = None
 
@@ -325,7 +332,7 @@ def quat_mean_unchecked(
             _warn_unconverged(max_iter, tol)
     elif method != "chordal":
         raise ValueError(f"method must be 'chordal' or 'geodesic', got {method!r}")
-    return _kq.quat_canonical(mean), iterations
+    return (_kq.quat_canonical(mean) if iterations else mean), iterations
 
 
 def pose_mean(poses, weights=None, *, method="chordal", axis=None, tol=None, max_iter=100):
