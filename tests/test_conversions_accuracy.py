@@ -267,10 +267,7 @@ def binding(request, monkeypatch):
         return run_loop(*args, **kwargs)
 
     monkeypatch.setattr(numba_backend, "run_loop", counting)
-    if request.param == "numba":
-        monkeypatch.setattr(kernel_module, "NUMBA_MIN", 0)
-    else:
-        monkeypatch.setattr(numba_backend, "available", lambda: False)
+    monkeypatch.setattr(kernel_module, "BINDING", request.param)
     yield request.param
     assert bool(runs) == (request.param == "numba"), f"{request.param}: {len(runs)} loops"
 

@@ -42,6 +42,7 @@ import pkgutil
 import subprocess
 import sys
 import textwrap
+import threading
 
 import array_api_strict as xps
 import mpmath
@@ -603,31 +604,103 @@ def test_out_buffer_must_fit():
 
 
 # -- when the numba loop is used -------------------------------------------------------
-class _CompileCalled(Exception):
-    pass
+def test_no_call_waits_for_a_compile(monkeypatch):
+    """A cold kernel never compiles on the caller's thread, at any size.
 
-
-def test_no_jit_at_or_below_threshold(monkeypatch):
-    """A cold kernel never compiles for <= NUMBA_MIN (1000) elements, and does above."""
-    assert kernel_module.NUMBA_MIN == 1000
-    calls = []
+    Until the background thread has its loop, a batch runs on Python floats (small)
+    or element-wise NumPy, with the results of the loop; once the loop is ready,
+    the loop serves the same call.
+    """
+    assert kernel_module.NUMBA_MIN is None
+    on_main = []
+    real = numba_backend.compile_loop
 
     def spy(kernel, *args):
-        calls.append(kernel.name)
-        raise _CompileCalled
+        on_main.append(threading.current_thread() is threading.main_thread())
+        return real(kernel, *args)
 
     monkeypatch.setattr(numba_backend, "compile_loop", spy)
     k0 = KERNELS["rotvec.quat_from_rotvec"]
     cold = Kernel(k0.fn, k0.inputs, k0.outputs, k0.params)
     rng = np.random.default_rng(11)
-    for shape in [(), (2,), (1000,), (10, 100), (1, 1000)]:
+    for shape in [(), (2,), (16,), (17,), (1000,), (10, 100), (1, 1000), (5000,)]:
         r = rng.standard_normal(shape + (3,))
-        cold(r)
-        cold(r.astype(np.float32))
-    assert calls == []
-    with pytest.raises(_CompileCalled):
-        cold(rng.standard_normal((1001, 3)))
-    assert calls == ["quat_from_rotvec"]
+        for a in (r, r.astype(np.float32)):
+            got = cold(a)
+            assert got.shape == shape + (4,) and got.dtype == a.dtype
+            eps = np.finfo(a.dtype).eps
+            np.testing.assert_allclose(got, k0(a, backend="numba"), rtol=0, atol=8 * eps)
+    loop = numba_backend.wait(cold, (False,), np.dtype(np.float64))
+    assert on_main == [False] * len(on_main) and on_main, on_main
+    runs = []
+    monkeypatch.setattr(numba_backend, "run_loop", lambda *a: runs.append(a[0]))
+    # With the loop ready, the general path takes it too (a 2-D batch).
+    cold(rng.standard_normal((10, 100, 3)))
+    assert runs == [loop]
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        "quaternion.quat_multiply",
+        "matrix.matrix_from_quat",
+        "matrix.quat_from_matrix",
+        "euler.euler_from_quat",
+        "se3.pose_compose",
+    ],
+)
+@pytest.mark.parametrize("dtype", [np.float64, np.float32], ids=["f64", "f32"])
+def test_one_element_loop_agrees(name, dtype):
+    """The compiled one-element loop (taken once a kernel is hot) equals Python floats."""
+    k = KERNELS[name]
+    params, arrays = sample(name, np.random.default_rng(12), 30, dtype)
+    ints = tuple(isinstance(p, (int, np.integer)) for p in params)
+    loop = numba_backend.wait(k, numba_backend.SINGLE, np.dtype(dtype), ints)
+    key = (np.dtype(dtype), ints) if params else np.dtype(dtype)
+    assert k._ready[numba_backend.SINGLE][key] is loop
+    runs = []
+    for i in range(30):
+        one = [np.ascontiguousarray(a[i]) for a in arrays]
+        got = _tuple(k(*params, *one))
+        want = k.python(*params, *[c for a in one for c in a.ravel().tolist()])
+        flat = np.concatenate([np.ravel(g) for g in got])
+        assert all(g.dtype == dtype for g in got)
+        err = np.abs(flat - np.array(want, dtype)) / np.maximum(1, np.abs(want))
+        runs.append(err.max())
+        buf = [np.full(s, np.nan, dtype) for s in k.outputs]
+        if len(buf) == 1:
+            assert k(*params, *one, out=buf[0]) is buf[0]
+            np.testing.assert_array_equal(buf[0], got[0])
+    tol = 2e-15 if dtype == np.float64 else 2e-6
+    assert max(runs) <= tol, max(runs)
+
+
+def test_first_batch_never_imports_numba():
+    """A fresh process whose loader is held back still answers batches correctly."""
+    code = textwrap.dedent(
+        """
+        import sys, threading
+        import numpy as np
+        from rigidkit._engine import numba_backend
+        numba_backend._work = threading.Event().wait  # the loader never starts work
+        import rigidkit as rk
+        rng = np.random.default_rng(0)
+        for n in (10, 2000, 300000):
+            q = rng.standard_normal((n, 4))
+            q /= np.linalg.norm(q, axis=-1, keepdims=True)
+            got = rk.conversions.quat_multiply(q, q[::-1])
+            w1, x1, y1, z1 = q.T
+            w2, x2, y2, z2 = q[::-1].T
+            assert np.allclose(got[:, 0], w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2)
+        assert "numba" not in sys.modules, "numba was imported on the caller's thread"
+        print("ok")
+        """
+    )
+    res = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120
+    )
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.strip() == "ok"
 
 
 def test_disable_numba_env_var():

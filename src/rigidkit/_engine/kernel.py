@@ -17,8 +17,14 @@ shape of each array input and output, and turns the function into a
 Dispatch, for ``a = kernel(arrays...)``:
 
 * NumPy, one element: the function itself over Python floats (lowest latency);
-* NumPy, more than ``NUMBA_MIN`` elements (or a loop already compiled in this
-  process): the fused numba loop, split over cores for large batches;
+* NumPy, a batch whose compiled loop is ready: the fused numba loop, called
+  from a generated entry point (:mod:`.dispatch`) that costs ~1 us, split over
+  cores for large batches;
+* NumPy, a batch whose loop is not ready yet: the loop is requested from the
+  background thread (:func:`.numba_backend.request`, which imports numba and
+  compiles or loads the loop from the disk cache) and this batch runs without
+  it, element by element on Python floats (up to ``ROWS_MAX`` elements) or
+  element-wise with NumPy functions. No call ever waits for numba or a compile;
 * otherwise, any array namespace: element-wise evaluation with ``xp`` functions.
 """
 
@@ -27,6 +33,7 @@ from __future__ import annotations
 import builtins
 import math
 import os
+import sys
 import types
 
 import numpy as np
@@ -35,8 +42,25 @@ from . import numba_backend
 from .namespace import device_of, float_dtype_of, is_numpy, namespace_of
 from .primitives import PRIMITIVES, math_bindings, sympy_bindings, xp_bindings
 
-#: Below this many elements a NumPy call never waits for a JIT compile.
-NUMBA_MIN = int(os.environ.get("RIGIDKIT_NUMBA_MIN", "1000"))
+#: A NumPy batch of more than this many elements whose compiled loop is not ready
+#: waits for it (compiled or loaded by the background thread) instead of taking
+#: the vectorised NumPy path meanwhile. None (the default): no batch ever waits.
+NUMBA_MIN = (
+    int(os.environ["RIGIDKIT_NUMBA_MIN"]) if os.environ.get("RIGIDKIT_NUMBA_MIN") else None
+)
+
+#: Force one NumPy binding for every batch of more than one element: ``"numba"``
+#: (waits for the compiled loop), ``"xp"`` (element-wise NumPy), or None (automatic).
+#: Tests set it to check one binding; the fast path steps aside when it is set.
+BINDING = None
+
+#: A kernel called this many times on one element asks for a compiled one-element
+#: loop (faster than Python floats there, mostly by not packing a new array).
+SINGLE_HOT = 64
+
+#: While a loop loads, batches up to this size run element by element on Python
+#: floats (about 1 us each), faster there than the element-wise NumPy path.
+ROWS_MAX = 16
 
 _HELPERS: dict[str, Helper] = {}
 _F64 = np.dtype(np.float64)
@@ -99,56 +123,6 @@ class _Rebindable:
         for dep in self.dependencies():
             env[dep.name] = make(dep.fn, env)
         return make(self.fn, env)
-
-
-def _single_source(kernel) -> str:
-    """Source of a kernel's one-element path: unpack, call on floats, pack.
-
-    Written out per kernel (no loops over inputs) because on one element the
-    bookkeeping costs as much as the arithmetic. It returns None unless every
-    array is a float32/float64 NumPy array of exactly its trailing shape (batch
-    shape ``()``), all of one dtype; the caller then takes the general path.
-    """
-    np_ = len(kernel.params)
-    params = [f"p{k}" for k in range(np_)]
-    names = [f"a{k}" for k in range(len(kernel.inputs))]
-    lines = [f"def single({', '.join(params + names)}):"]
-    checks = [f"type({a}) is not ndarray" for a in names]
-    checks += [f"{a}.shape != {tuple(s)!r}" for a, s in zip(names, kernel.inputs)]
-    lines.append(f"    if {' or '.join(checks)}:")
-    lines.append("        return None")
-    lines.append(f"    dt = {names[0]}.dtype")
-    same = "".join(f" or {a}.dtype is not dt" for a in names[1:])
-    lines.append(f"    if (dt is not F64 and dt is not F32){same}:")
-    lines.append("        return None")
-    call = list(params)
-    for a, s in zip(names, kernel.inputs):
-        if len(s) == 0:
-            call.append(f"{a}.item()")
-        elif len(s) == 1:
-            call.append(f"*{a}.tolist()")
-        else:
-            call.append(f"*{a}.ravel().tolist()")
-    lines.append(f"    r = py({', '.join(call)})")
-    lines.append("    flat = array(r, dt)")
-    if len(kernel.outputs) == 1:
-        s = kernel.outputs[0]
-        lines.append(
-            "    return flat" if len(s) == 1 else f"    return flat.reshape({s!r})"
-        )
-    else:
-        parts, start = [], 0
-        for s in kernel.outputs:
-            m = math.prod(s)
-            if not s:
-                parts.append(f"flat[{start}]")  # a NumPy scalar: shape ()
-            elif len(s) == 1:
-                parts.append(f"flat[{start}:{start + m}]")
-            else:
-                parts.append(f"flat[{start}:{start + m}].reshape({s!r})")
-            start += m
-        lines.append(f"    return ({', '.join(parts)},)")
-    return "\n".join(lines) + "\n"
 
 
 def _inline_branches():
@@ -225,12 +199,12 @@ class Kernel(_Rebindable):
         self.params = tuple(params)
         self._py = None
         self._sym = None
-        self._loop = None
-        self._warm: set = set()
         self._xp_cache: dict = {}
-        # One output: its shape, () when it is a flat vector (no reshape needed).
-        self._single = None
-        self._nargs = len(self.params) + len(self.inputs)
+        # Compiled numba loops, ready to call: {broadcast pattern: {dtype: loop}}.
+        # Filled by the background loader (numba_backend.request); read without a
+        # lock by the fast path, so entries are only ever added.
+        self._ready: dict = {}
+        self._nsingle: dict = {}  # one-element calls counted per loop key
 
     # -- scalar bindings -------------------------------------------------
     @property
@@ -259,13 +233,62 @@ class Kernel(_Rebindable):
             NumPy buffers of shape ``(..., *output_shape)`` to write into.
         backend : {"numba", "xp", "python"}, optional
             Force a binding (tests use this to compare them).
+
+        The first call generates this kernel's fast entry point
+        (:func:`.dispatch.fast_source`) and makes it the ``__call__`` of a
+        subclass of one instance, so later calls go straight to it: one Python
+        frame between the caller and the numba loop.
         """
-        if backend is None and len(args) == self._nargs:
-            if self._single is None:
-                self._single = self._make_single()
-            single = self._single(*args)
-            if single is not None:
-                return single if out is None else self._write_out(single, out)
+        fast = self._make_fast()
+        self.__class__ = type(f"Kernel_{self.name}", (type(self),), {"__call__": fast})
+        return fast(self, *args, out=out, backend=backend)
+
+    def _make_fast(self):
+        """Generate this kernel's fast entry point (see :mod:`.dispatch`)."""
+        from .dispatch import fast_source
+
+        env = {
+            "ndarray": np.ndarray,
+            "array": np.array,
+            "empty": np.empty,
+            "F64": _F64,
+            "F32": _F32,
+            "K": sys.modules[__name__],
+            "PMIN": numba_backend.PARALLEL_MIN,
+            "py": self.python,
+            "INTS": _INTS,
+        }
+        for j in [None, *range(len(self.inputs))]:
+            bcast = tuple(k == j for k in range(len(self.inputs)))
+            if j is not None and len(self.inputs) < 2:
+                continue
+            env["R_" + "".join("b" if b else "n" for b in bcast)] = self._ready.setdefault(
+                bcast, {}
+            )
+        single = numba_backend.has_single(self)
+        if single:
+            env["R_single"] = self._ready.setdefault(numba_backend.SINGLE, {})
+        src = fast_source(self, has_single=single)
+        exec(compile(src, f"<rigidkit fast {self.name}>", "exec"), env)
+        return env["fast"]
+
+    def _single_seen(self, key):
+        """Count one-element calls; the 64th asks for the compiled one-element loop.
+
+        Only kernels called often one element at a time get it: it is one more
+        compile (in the background) per kernel and dtype.
+        """
+        n = self._nsingle.get(key, 0)
+        if n < SINGLE_HOT:
+            self._nsingle[key] = n + 1
+        elif n == SINGLE_HOT:
+            self._nsingle[key] = n + 1
+            if numba_backend.available():
+                dtype, ints = key if self.params else (key, ())
+                numba_backend.request(self, numba_backend.SINGLE, dtype, ints)
+
+    def _call(self, *args, out=None, backend=None):
+        """The general path: any namespace, broadcasting, conversions, forced bindings."""
         nparams = len(self.params)
         params = args[:nparams]
         arrays = args[nparams:]
@@ -283,17 +306,35 @@ class Kernel(_Rebindable):
             return self._call_numpy(params, arrays, batch, out, backend)
         return self._call_xp(xp, params, arrays, batch)
 
-    def _make_single(self):
-        """Generate this kernel's one-element fast path (see :func:`_single_source`)."""
-        env = {
-            "ndarray": np.ndarray,
-            "array": np.array,
-            "F64": _F64,
-            "F32": _F32,
-            "py": self.python,
-        }
-        exec(compile(_single_source(self), f"<rigidkit single {self.name}>", "exec"), env)
-        return env["single"]
+    def _single_out(self, res, out, dt):
+        """Write one element's results ``res`` (a tuple of floats) into ``out=``."""
+        outs = [out] if len(self.outputs) == 1 else list(out)
+        k = 0
+        for o, s in zip(outs, self.outputs):
+            if type(o) is not np.ndarray or o.shape != s:
+                raise ValueError(
+                    f"{self.name}: out= needs a NumPy array of shape {s}, got "
+                    f"{getattr(o, 'shape', type(o).__name__)}"
+                )
+            m = math.prod(s)
+            if not s:
+                o[()] = res[k]
+            elif len(s) == 1:
+                o[:] = res[k : k + m]
+            else:
+                o.reshape(-1)[:] = res[k : k + m]
+            k += m
+        return self._finish(outs)
+
+    def _loop_ready(self, bcast, dtype, ints, loop):
+        """Called by the background loader when a compiled loop can be used.
+
+        The table of a broadcast pattern is keyed by dtype, and for a kernel with
+        parameters by ``(dtype, ints)`` (which parameters are integers, see
+        :func:`_ints`): each combination is its own compiled signature.
+        """
+        key = (dtype, ints) if self.params else dtype
+        self._ready.setdefault(bcast, {})[key] = loop
 
     def _batch_shape(self, xp, arrays):
         shapes = []
@@ -326,20 +367,56 @@ class Kernel(_Rebindable):
         if n == 0:
             return self._finish(self._outputs(batch, dtype, out))
         if backend is None:
-            if n == 1:
-                backend = "python"
-            elif (n > NUMBA_MIN or dtype in self._warm) and numba_backend.available():
+            backend = BINDING if n > 1 else "python"
+        if backend is None:
+            bcast = self._pattern(arrays, n)
+            ints = _ints(params)
+            key = (dtype, ints) if params else dtype
+            if self._ready.get(bcast, {}).get(key) is not None:
+                backend = "numba"
+            elif NUMBA_MIN is not None and n > NUMBA_MIN and numba_backend.available():
                 backend = "numba"
             else:
-                res = self._call_xp(np, params, arrays, batch)
+                # Not ready: ask the background thread for the loop and serve this
+                # batch without it (never wait for numba's import or a compile).
+                if numba_backend.available():
+                    numba_backend.request(self, bcast, dtype, ints)
+                if n <= ROWS_MAX:
+                    res = self._call_rows(params, arrays, batch, dtype, n)
+                else:
+                    res = self._call_xp(np, params, arrays, batch)
                 return res if out is None else self._write_out(res, out)
         if backend == "python":
             return self._call_python(params, arrays, batch, dtype, out)
         if backend == "numba":
             return self._call_numba(params, arrays, batch, dtype, out, n)
-        if backend == "xp":  # pragma: no cover - handled by caller
-            return self._call_xp(np, params, arrays, batch)
+        if backend == "xp":
+            res = self._call_xp(np, params, arrays, batch)
+            return res if out is None else self._write_out(res, out)
         raise ValueError(f"unknown backend {backend!r}")
+
+    def _pattern(self, arrays, n):
+        """Which inputs are one row for the whole batch (read once by the loop)."""
+        return tuple(n != 1 and a.size == math.prod(t) for a, t in zip(arrays, self.inputs))
+
+    def _call_rows(self, params, arrays, batch, dtype, n):
+        """A small batch element by element on Python floats (while a loop loads)."""
+        rows = [
+            np.broadcast_to(a, batch + t).reshape(n, math.prod(t)).tolist()
+            for a, t in zip(arrays, self.inputs)
+        ]
+        py = self.python
+        res = [py(*params, *[c for r in rows for c in r[i]]) for i in range(n)]
+        flat = np.array(res, dtype=dtype).reshape(n, -1)
+        if len(self.outputs) == 1:
+            return flat.reshape(batch + self.outputs[0])
+        outs, k = [], 0
+        for s in self.outputs:
+            m = math.prod(s)
+            # A copy: results must be C-contiguous, as the loop's are.
+            outs.append(np.ascontiguousarray(flat[:, k : k + m]).reshape(batch + s))
+            k += m
+        return self._finish(outs)
 
     def _outputs(self, batch, dtype, out):
         if out is None:
@@ -381,36 +458,23 @@ class Kernel(_Rebindable):
 
     def _call_numba(self, params, arrays, batch, dtype, out, n):
         outs = self._outputs(batch, dtype, out)
-        flat_max = numba_backend.FLAT_MAX
+        bcast = self._pattern(arrays, n)
         ins = []
-        bcast = []
-        for a, trail in zip(arrays, self.inputs):
-            m = math.prod(trail)
-            size = a.size // m if m else 0
-            if size == 1 and n != 1:  # one row for the whole batch: read it once
-                ins.append((np.ascontiguousarray(a, dtype=dtype).reshape(m), None))
-                bcast.append(True)
+        for a, trail, row in zip(arrays, self.inputs, bcast):
+            if row:
+                ins.append(np.ascontiguousarray(a, dtype=dtype).reshape(-1))
                 continue
-            if size != n:
+            if a.shape != batch + trail:
                 a = np.broadcast_to(a, batch + trail)
-            flat = np.ascontiguousarray(a, dtype=dtype)
-            ins.append(
-                (flat.reshape(n * m), m) if m <= flat_max else (flat.reshape(n, m), 0)
-            )
-            bcast.append(False)
-        key = tuple(bcast)
-        if self._loop is None:
-            self._loop = {}
-        loop = self._loop.get(key)
+            ins.append(np.ascontiguousarray(a, dtype=dtype).reshape((n,) + trail))
+        ints = _ints(params)
+        loop = self._ready.get(bcast, {}).get((dtype, ints) if params else dtype)
         if loop is None:
-            loop = self._loop[key] = numba_backend.compile_loop(self, key)
-        oargs = []
-        for o, s in zip(outs, self.outputs):
-            m = math.prod(s)
-            oargs.append((o.reshape(n * m), m) if m <= flat_max else (o.reshape(n, m), 0))
-        if n:
-            numba_backend.run_loop(loop, n, list(params), ins, oargs)
-            self._warm.add(dtype)
+            if not numba_backend.available():
+                raise RuntimeError(f"{self.name}: numba is not available")
+            loop = numba_backend.wait(self, bcast, dtype, ints)
+        oargs = [o.reshape((n,) + s) for o, s in zip(outs, self.outputs)]
+        numba_backend.run_loop(loop, n, list(params), ins, bcast, oargs)
         return self._finish(outs)
 
     # -- any array namespace --------------------------------------------------
@@ -446,6 +510,14 @@ class Kernel(_Rebindable):
             else:
                 outs.append(xp.reshape(xp.stack(parts, axis=-1), batch + s))
         return self._finish(outs)
+
+
+_INTS = (int, np.integer)
+
+
+def _ints(params) -> tuple:
+    """Which static parameters are integers (int64 in a loop; floats are float64)."""
+    return tuple(isinstance(p, _INTS) for p in params)
 
 
 def kernel(inputs, outputs, params=()):

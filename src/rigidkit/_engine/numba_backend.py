@@ -1,13 +1,26 @@
-"""Generate, compile and cache the fused numba loop of a kernel.
+"""Generate, compile, cache and load the fused numba loop of a kernel.
 
 For each kernel we write one small Python module: the primitive prelude, the
 source of the kernel and of every helper it calls, and a loop over the batch that
 reads the components of each input, calls the kernel, and writes each output
 component. The module lives in a cache folder named after a hash of its text, so
-numba's on-disk cache (``cache=True``) is valid across processes and is refreshed
-whenever a kernel changes. The loop is compiled with ``nogil=True``; large batches
-are split over threads (see :func:`run_loop`), so one compile serves the serial and
-the parallel path.
+numba's on-disk cache is valid across processes and is refreshed whenever a
+kernel changes.
+
+Each loop is compiled for one explicit signature (per dtype and broadcast
+pattern; see :func:`signature`), so a dispatcher never compiles again: an
+argument that does not match raises ``TypeError`` instead of compiling on the
+caller's thread. Inputs are typed read-only, which writable arrays convert to.
+
+Loops are compiled or loaded from the disk cache by one background thread
+(:func:`request`), which also imports numba: a caller never waits for numba's
+import or a compile, and is served by the vectorised NumPy path until its loop
+is ready. :func:`wait` blocks for a loop (tests and ``backend="numba"``), and
+``python -m rigidkit._engine.numba_backend`` compiles every shipped kernel (an
+install step: afterwards a fresh process only loads from disk).
+
+The loop is compiled with ``nogil=True``; large batches are split over threads
+(see :func:`run_loop`), so one compile serves the serial and the parallel path.
 """
 
 from __future__ import annotations
@@ -27,16 +40,19 @@ PARALLEL_MIN = int(os.environ.get("RIGIDKIT_PARALLEL_MIN", "200000"))
 
 
 def available() -> bool:
-    """True when numba can be imported and is not disabled by RIGIDKIT_DISABLE_NUMBA."""
+    """True when numba is installed and not disabled by RIGIDKIT_DISABLE_NUMBA.
+
+    Does not import numba (that takes ~0.5 s; the background thread does it).
+    """
     global _AVAILABLE
     if os.environ.get("RIGIDKIT_DISABLE_NUMBA", "") not in ("", "0"):
         return False
     if _AVAILABLE is None:
-        try:
-            import numba  # noqa: F401
+        import importlib.util
 
-            _AVAILABLE = True
-        except Exception:  # pragma: no cover - depends on the machine
+        try:
+            _AVAILABLE = importlib.util.find_spec("numba") is not None
+        except (ImportError, ValueError):  # pragma: no cover - broken install
             _AVAILABLE = False
     return _AVAILABLE
 
@@ -73,36 +89,76 @@ def function_source(fn) -> str:
 FLAT_MAX = 4
 
 
-def _loop_source(kernel, bcast=()) -> str:
-    """Loop over ``range(n)`` (a known non-negative index: LLVM vectorises it).
+#: The broadcast pattern of a kernel's one-element loop: every input and output of
+#: exactly its trailing shape (no batch axis), one evaluation, no loop.
+SINGLE = "single"
 
-    Inputs flagged in ``bcast`` are a single row, read once before the loop.
+
+def _single_source(kernel) -> str:
+    """One evaluation on arrays of exactly their trailing shapes (see ``SINGLE``)."""
+    nparams = len(kernel.params)
+    args = [f"p{k}" for k in range(nparams)]
+    pre, call = [], [f"p{k}" for k in range(nparams)]
+    for k, shape in enumerate(kernel.inputs):
+        args.append(f"A{k}")
+        pre.append(f"    a{k} = A{k}.reshape({_size(shape)})")
+        call += [f"a{k}[{c}]" for c in range(_size(shape))]
+    body = [f"    r = {kernel.name}({', '.join(call)})"]
+    j = 0
+    for k, shape in enumerate(kernel.outputs):
+        args.append(f"O{k}")
+        pre.append(f"    o{k} = O{k}.reshape({_size(shape)})")
+        for c in range(_size(shape)):
+            body.append(f"    o{k}[{c}] = r[{j}]")
+            j += 1
+    return f"def loop({', '.join(args)}):\n" + "\n".join(pre + body) + "\n"
+
+
+def has_single(kernel) -> bool:
+    """Whether ``kernel`` can have a one-element loop (no 0-d input or output)."""
+    return all(kernel.inputs) and all(kernel.outputs)
+
+
+def _loop_source(kernel, bcast=()) -> str:
+    """The loop over the batch, on arrays of their natural shape.
+
+    Arguments: the static parameters, one C-contiguous array per input of shape
+    ``(n, *input_shape)`` (a broadcast input, flagged in ``bcast``: its single row,
+    flattened), then one per output of shape ``(n, *output_shape)``. Rows at most
+    ``FLAT_MAX`` wide are read through flat views with a constant stride
+    (``a[4 * i + c]``), which LLVM vectorises; the loop runs over ``range(n)``
+    (a known non-negative index). A broadcast row is read once, before the loop.
     """
     nparams = len(kernel.params)
-    args = ["n"] + [f"p{k}" for k in range(nparams)]
-    pre = []
+    args = [f"p{k}" for k in range(nparams)]
+    pre = ["    n = O0.shape[0]"]
     call = [f"p{k}" for k in range(nparams)]
     for k, shape in enumerate(kernel.inputs):
-        args.append(f"a{k}")
+        args.append(f"A{k}")
         w = _size(shape)
         if k < len(bcast) and bcast[k]:
-            pre += [f"    b{k}_{c} = a{k}[{c}]" for c in range(w)]
+            pre += [f"    b{k}_{c} = A{k}[{c}]" for c in range(w)]
             call += [f"b{k}_{c}" for c in range(w)]
         elif w <= FLAT_MAX:
+            pre.append(f"    a{k} = A{k}.reshape(A{k}.size)")
             call += [f"a{k}[{w} * i + {c}]" for c in range(w)]
         else:
+            pre.append(f"    a{k} = A{k}.reshape(n, {w})")
             call += [f"a{k}[i, {c}]" for c in range(w)]
     body = [f"        r = {kernel.name}({', '.join(call)})"]
     j = 0
     for k, shape in enumerate(kernel.outputs):
-        args.append(f"o{k}")
+        args.append(f"O{k}")
         w = _size(shape)
+        if w <= FLAT_MAX:
+            pre.append(f"    o{k} = O{k}.reshape(O{k}.size)")
+        else:
+            pre.append(f"    o{k} = O{k}.reshape(n, {w})")
         for c in range(w):
             target = f"o{k}[{w} * i + {c}]" if w <= FLAT_MAX else f"o{k}[i, {c}]"
             body.append(f"        {target} = r[{j}]")
             j += 1
-    head = "@numba.njit(cache=CACHE, nogil=True, error_model='numpy')\n"
-    head += f"def loop({', '.join(args)}):\n"
+    head = f"def loop({', '.join(args)}):\n"
     return head + "\n".join(pre + ["    for i in range(n):"] + body) + "\n"
 
 
@@ -139,12 +195,13 @@ def module_source(kernel, bcast=()) -> str:
     )
     for f in fns:
         parts.append("\n\n" + deco + "\n" + function_source(f.fn))
-    parts.append("\n\n" + _loop_source(kernel, bcast))
+    loop = _single_source(kernel) if bcast == SINGLE else _loop_source(kernel, bcast)
+    parts.append("\n\n" + loop)
     return "\n".join(parts)
 
 
-def compile_loop(kernel, bcast=()):
-    """Import (and so compile on first call) the generated module of ``kernel``."""
+def _module(kernel, bcast):
+    """Import the generated module of ``kernel`` for broadcast pattern ``bcast``."""
     import hashlib
     import importlib.util
     import tempfile
@@ -157,22 +214,147 @@ def compile_loop(kernel, bcast=()):
     folder = _cache_dir()
     with _LOCK:
         if modname in sys.modules:
-            return sys.modules[modname].loop
+            return sys.modules[modname], folder is not None
         if folder is None:
-            namespace = {"CACHE": False}
-            exec(compile(src, f"<rigidkit kernel {kernel.name}>", "exec"), namespace)
-            return namespace["loop"]
+            module = type(sys)(modname)
+            exec(compile(src, f"<rigidkit kernel {kernel.name}>", "exec"), module.__dict__)
+            sys.modules[modname] = module
+            return module, False
         path = os.path.join(folder, modname + ".py")
         if not os.path.exists(path):
             fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
             with os.fdopen(fd, "w") as fh:
-                fh.write("CACHE = True\n" + src)
+                fh.write(src)
             os.replace(tmp, path)
         spec = importlib.util.spec_from_file_location(modname, path)
         module = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(module)
         sys.modules[modname] = module
-        return module.loop
+        return module, True
+
+
+def signature(kernel, bcast, dtype, ints=()):
+    """The one numba signature of a loop: its parameters, read-only inputs, outputs.
+
+    Parameters are int64 where ``ints`` says so (a kernel may index a tuple with
+    one), float64 otherwise. Inputs are ``(n, *shape)`` arrays (a broadcast one
+    its flat row) of ``dtype``, typed read-only so that read-only and writable
+    arrays both match; outputs are writable ``(n, *shape)`` arrays.
+    """
+    from numba import types
+
+    dt = types.float32 if dtype.itemsize == 4 else types.float64
+    args = [types.int64 if i else types.float64 for i in ints]
+    if bcast == SINGLE:
+        args += [types.Array(dt, len(s), "C", readonly=True) for s in kernel.inputs]
+        args += [types.Array(dt, len(s), "C") for s in kernel.outputs]
+        return types.void(*args)
+    for k, shape in enumerate(kernel.inputs):
+        ndim = 1 if (k < len(bcast) and bcast[k]) else 1 + len(shape)
+        args.append(types.Array(dt, ndim, "C", readonly=True))
+    args += [types.Array(dt, 1 + len(shape), "C") for shape in kernel.outputs]
+    return types.void(*args)
+
+
+def compile_loop(kernel, bcast, dtype, ints=()):
+    """The compiled loop of ``kernel`` (from the disk cache when it is there).
+
+    One dispatcher per dtype and broadcast pattern, compiled for its single
+    :func:`signature` only, with further compiles disabled.
+    """
+    import numba
+
+    module, cache = _module(kernel, bcast)
+    sig = signature(kernel, bcast, dtype, ints)
+    return numba.njit([sig], cache=cache, nogil=True, error_model="numpy")(module.loop)
+
+
+# -- the background loader ---------------------------------------------------------
+_JOBS = None
+_PENDING: dict = {}
+_THREAD = None
+
+
+class _Job:
+    __slots__ = ("kernel", "bcast", "dtype", "ints", "done", "loop", "error")
+
+    def __init__(self, kernel, bcast, dtype, ints):
+        self.kernel, self.bcast, self.dtype, self.ints = kernel, bcast, dtype, ints
+        self.done = threading.Event()
+        self.loop = None
+        self.error = None
+
+
+def request(kernel, bcast, dtype, ints=()) -> _Job:
+    """Queue the loop of ``kernel`` for the background thread (once per key).
+
+    When it is ready the thread calls ``kernel._loop_ready(bcast, dtype, ints, loop)``.
+    """
+    global _JOBS, _THREAD
+    key = (id(kernel), bcast, dtype.char, ints)
+    job = _PENDING.get(key)
+    if job is not None:
+        return job
+    with _LOCK:
+        job = _PENDING.get(key)
+        if job is None:
+            job = _PENDING[key] = _Job(kernel, bcast, dtype, ints)
+            if _JOBS is None:
+                import queue
+
+                _JOBS = queue.SimpleQueue()
+            _JOBS.put(job)
+            if _THREAD is None:
+                # A daemon: a process that ends does not wait for a compile (the
+                # next one finds whatever was finished in the disk cache).
+                _THREAD = threading.Thread(target=_work, name="rigidkit-numba", daemon=True)
+                _THREAD.start()
+    return job
+
+
+def wait(kernel, bcast, dtype, ints=()):
+    """The loop of ``kernel``, blocking until the background thread has it."""
+    job = request(kernel, bcast, dtype, ints)
+    job.done.wait()
+    if job.error is not None:
+        raise job.error
+    return job.loop
+
+
+def drain(timeout=None) -> bool:
+    """Wait until every loop requested so far is ready (benchmarks and tests).
+
+    Returns False if ``timeout`` (seconds) ran out first.
+    """
+    import time
+
+    end = None if timeout is None else time.monotonic() + timeout
+    for job in list(_PENDING.values()):
+        left = None if end is None else max(0.0, end - time.monotonic())
+        if not job.done.wait(left):
+            return False
+    return True
+
+
+def _work():
+    global _AVAILABLE
+    try:
+        import numba  # noqa: F401
+    except Exception as exc:  # pragma: no cover - depends on the machine
+        _AVAILABLE = False
+        error = RuntimeError(f"numba could not be imported: {exc}")
+    else:
+        error = None
+    while True:
+        job = _JOBS.get()
+        try:
+            if error is not None:
+                raise error
+            job.loop = compile_loop(job.kernel, job.bcast, job.dtype, job.ints)
+            job.kernel._loop_ready(job.bcast, job.dtype, job.ints, job.loop)
+        except BaseException as exc:  # noqa: BLE001 - handed to whoever waits
+            job.error = exc
+        job.done.set()
 
 
 def _pool():
@@ -209,34 +391,56 @@ def _workers() -> int:
     return max(1, min(n, int(n - others + 0.5)))
 
 
-def run_loop(loop, n, params, ins, outs):
-    """Run ``loop(n, *params, *ins, *outs)``, split over threads if it pays.
+def run_loop(loop, n, params, ins, bcast, outs):
+    """Run ``loop(*params, *ins, *outs)``, split over threads if it pays.
 
-    ``ins``/``outs`` are ``(array, width)``: ``width`` is the row width of a flat
-    1-D array, 0 for a 2-D ``(n, width)`` array, None for a broadcast row. Each
-    thread gets views of its rows, so every loop runs over ``range(its n)``.
+    ``ins``/``outs`` are ``(n, ...)`` arrays, except the inputs flagged in
+    ``bcast`` (one row for the whole batch). Each thread gets views of its rows.
     """
+    workers = 1 if n < PARALLEL_MIN else _workers()
+    if workers < 2:
+        loop(*params, *ins, *outs)
+        return
 
     def chunk(start, stop):
         args = list(params)
-        for a, w in (*ins, *outs):
-            if w is None:
-                args.append(a)
-            elif w:
-                args.append(a[w * start : w * stop])
-            else:
-                args.append(a[start:stop])
+        args += [a if b else a[start:stop] for a, b in zip(ins, bcast)]
+        args += [o[start:stop] for o in outs]
         return args
 
-    workers = 1 if n < PARALLEL_MIN else _workers()
-    if workers < 2:
-        loop(n, *chunk(0, n))
-        return
     bounds = [n * k // workers for k in range(workers + 1)]
     futures = [
-        _pool().submit(loop, bounds[k + 1] - bounds[k], *chunk(bounds[k], bounds[k + 1]))
-        for k in range(1, workers)
+        _pool().submit(loop, *chunk(bounds[k], bounds[k + 1])) for k in range(1, workers)
     ]
-    loop(bounds[1] - bounds[0], *chunk(bounds[0], bounds[1]))
+    loop(*chunk(bounds[0], bounds[1]))
     for f in futures:
         f.result()
+
+
+def precompile(kernels, dtypes=("float64", "float32"), verbose=False) -> int:
+    """Compile (or load) the plain loop (no broadcast input) of each of ``kernels``.
+
+    Kernels with static parameters are left out: their loops are typed by the
+    parameters' values (see :func:`signature`), compiled when first called.
+    Returns how many loops were compiled or loaded. Meant for install time:
+    ``python -m rigidkit.applications.precompile`` passes every shipped kernel,
+    and a later process's background thread only loads the loops from disk.
+    """
+    import time
+
+    import numpy as np
+
+    count = 0
+    for kern in kernels:
+        if kern.params:
+            continue
+        bcast = (False,) * len(kern.inputs)
+        for name in dtypes:
+            t0 = time.perf_counter()
+            loop = compile_loop(kern, bcast, np.dtype(name))
+            kern._loop_ready(bcast, np.dtype(name), (), loop)
+            count += 1
+            if verbose:
+                dt = time.perf_counter() - t0
+                print(f"{kern.fn.__module__}.{kern.name} {name}: {dt * 1e3:.0f} ms")
+    return count

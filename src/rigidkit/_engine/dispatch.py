@@ -1,0 +1,210 @@
+"""The generated fast entry point of a kernel: its common calls in a few checks.
+
+Every kernel call with NumPy arrays pays this function's checks before any work,
+so for each kernel we write one, straight-line, with its shapes as constants (no
+loops over the inputs, no lists, no ``math.prod``): on a 10-element batch the
+bookkeeping would otherwise cost more than the arithmetic. It serves
+
+* one element (every array exactly its trailing shape, batch ``()``): the kernel
+  over Python floats;
+* a batch with one batch axis, every input either of that batch or a single row
+  for the whole batch (``R0.apply(points)``), C-contiguous, all float32 or all
+  float64, below ``PARALLEL_MIN``, whose compiled loop is ready: the numba loop
+  called directly, into a fresh array or a matching ``out=`` buffer.
+
+Anything else (other array namespaces, broadcasting between batch shapes, N-D
+batches, conversions, a loop not yet loaded, a forced binding, bad shapes)
+returns to :meth:`Kernel._call`, the general path, with the same arguments.
+
+The source for ``quat_apply`` (inputs ``(4,), (3,)``, output ``(3,)``) reads::
+
+    def fast(self, a0, a1, out=None, backend=None):
+        if backend is None and type(a0) is ndarray and type(a1) is ndarray \
+and K.BINDING is None:
+            dt = a0.dtype
+            s0 = a0.shape
+            s1 = a1.shape
+            if a1.dtype is dt:
+                if s0 == (4,) and s1 == (3,):
+                    ...  # one element
+                elif s0[-1:] == (4,) and s1[-1:] == (3,):
+                    b0 = s0[:-1]
+                    b1 = s1[:-1]
+                    ...  # one branch per broadcast pattern
+    return self._call(a0, a1, out=out, backend=backend)
+"""
+
+from __future__ import annotations
+
+import math
+
+
+def _trail_check(shape_var: str, trail: tuple) -> str:
+    nt = len(trail)
+    return f"{shape_var}[-{nt}:] == {trail!r}" if nt else ""
+
+
+def _batch_expr(shape_var: str, trail: tuple) -> str:
+    nt = len(trail)
+    return f"{shape_var}[:-{nt}]" if nt else shape_var
+
+
+def _loop_key(params) -> str:
+    """Source of the key of a ready-loop table: the dtype, and which params are ints."""
+    if not params:
+        return "dt"
+    return "(dt, (" + "".join(f"isinstance({p}, INTS), " for p in params) + "))"
+
+
+def _run_single(outs, args) -> list[str]:
+    """Lines that run the one-element ``loop`` into fresh outputs or a fitting ``out=``."""
+    onames = [f"o{k}" for k in range(len(outs))]
+    lines = ["if out is None:"]
+    lines += [f"    {o} = empty({tuple(s)!r}, dt)" for o, s in zip(onames, outs)]
+    lines.append(f"    loop({', '.join(args + onames)})")
+    lines.append(
+        f"    return {onames[0]}"
+        if len(outs) == 1
+        else f"    return ({', '.join(onames)},)"
+    )
+    if len(outs) == 1:
+        lines.append(
+            "if type(out) is ndarray and out.dtype is dt and out.shape == "
+            f"{tuple(outs[0])!r} and out.flags.c_contiguous:"
+        )
+        lines.append(f"    loop({', '.join(args)}, out)")
+        lines.append("    return out")
+    return lines
+
+
+def fast_source(kernel, has_single=False) -> str:
+    """Source of ``fast(self, *params, *arrays, out=None, backend=None)``.
+
+    ``has_single``: the kernel can have a one-element loop (table ``R_single``).
+    """
+    nparams = len(kernel.params)
+    params = [f"p{k}" for k in range(nparams)]
+    names = [f"a{k}" for k in range(len(kernel.inputs))]
+    ins = kernel.inputs
+    outs = kernel.outputs
+    signature = ", ".join(params + names + ["out=None", "backend=None"])
+    L = [f"def fast(self, {signature}):"]
+    types_ok = " and ".join(f"type({a}) is ndarray" for a in names)
+    L.append(f"    if backend is None and {types_ok}:")
+    L.append(f"        dt = {names[0]}.dtype")
+    for k, a in enumerate(names):
+        L.append(f"        s{k} = {a}.shape")
+    same = " and ".join(f"{a}.dtype is dt" for a in names[1:]) or "True"
+    L.append(f"        if {same}:")
+    # -- one element -------------------------------------------------------------
+    single = " and ".join(f"s{k} == {tuple(t)!r}" for k, t in enumerate(ins))
+    L.append(f"            if {single}:")
+    L.append("                if dt is F64 or dt is F32:")
+    if has_single:
+        # The compiled one-element loop (once this kernel is hot at one element):
+        # ~0.4 us of dispatch, less than packing Python floats into a new array.
+        lkey = _loop_key(params)
+        L.append(f"                    loop = R_single.get({lkey})")
+        contig = " and ".join(f"{a}.flags.c_contiguous" for a in names)
+        L.append(f"                    if loop is not None and {contig}:")
+        sargs = list(params) + names
+        L += ["                        " + x for x in _run_single(outs, sargs)]
+        L.append("                    elif loop is None:")
+        L.append(f"                        self._single_seen({lkey})")
+    call = list(params)
+    for a, s in zip(names, ins):
+        if len(s) == 0:
+            call.append(f"{a}.item()")
+        elif len(s) == 1:
+            call.append(f"*{a}.tolist()")
+        else:
+            call.append(f"*{a}.ravel().tolist()")
+    L.append(f"                    r = py({', '.join(call)})")
+    L.append("                    if out is None:")
+    L += ["                        " + line for line in _pack_single(outs)]
+    L.append("                    return self._single_out(r, out, dt)")
+    # -- one batch axis: index tests on the shapes (a slice costs ~60 ns each) -------
+    patterns = [(None, tuple(False for _ in ins))]
+    if len(ins) > 1:
+        for j in range(len(ins)):
+            patterns.append((j, tuple(k == j for k in range(len(ins)))))
+    kw = "elif"
+    for j, bcast in patterns:
+        others = [k for k in range(len(ins)) if k != j]
+        ref = others[0]
+        conds = [] if j is None else [f"s{j} == {tuple(ins[j])!r}"]
+        for k in others:
+            t = ins[k]
+            conds.append(f"len(s{k}) == {1 + len(t)}")
+            conds += [f"s{k}[{1 + d}] == {size}" for d, size in enumerate(t)]
+            if k != ref:
+                conds.append(f"s{k}[0] == s{ref}[0]")
+        L.append(f"            {kw} {' and '.join(conds)} and K.BINDING is None:")
+        L.append(f"                loop = R{_tag(bcast)}.get({_loop_key(params)})")
+        # A broadcast row of one axis is passed as it is (others are raveled).
+        plain = [k for k in range(len(ins)) if k != j or len(ins[k]) == 1]
+        contig = " and ".join(f"{names[k]}.flags.c_contiguous" for k in plain)
+        L.append(f"                n = s{ref}[0]")
+        L.append(f"                if loop is not None and {contig} and n < PMIN:")
+        args = list(params)
+        for k, (a, t) in enumerate(zip(names, ins)):
+            args.append(f"{a}.ravel()" if bcast[k] and len(t) != 1 else a)
+        L += ["                    " + line for line in _run_batch(outs, args)]
+    L.append(
+        f"    return self._call({', '.join(params + names)}, out=out, backend=backend)"
+    )
+    return "\n".join(L) + "\n"
+
+
+def _tag(bcast) -> str:
+    """Name suffix of the ready-loop table of a broadcast pattern."""
+    return "_" + "".join("b" if b else "n" for b in bcast)
+
+
+def _pack_single(outs) -> list[str]:
+    """Lines that return the one-element result ``r`` as arrays of dtype ``dt``."""
+    if len(outs) == 1:
+        s = outs[0]
+        if len(s) == 1:
+            return ["return array(r, dt)"]
+        return [f"return array(r, dt).reshape({s!r})"]
+    lines = ["flat = array(r, dt)"]
+    parts, start = [], 0
+    for s in outs:
+        m = math.prod(s)
+        if not s:
+            parts.append(f"flat[{start}]")  # a NumPy scalar: shape ()
+        elif len(s) == 1:
+            parts.append(f"flat[{start}:{start + m}]")
+        else:
+            parts.append(f"flat[{start}:{start + m}].reshape({s!r})")
+        start += m
+    lines.append(f"return ({', '.join(parts)},)")
+    return lines
+
+
+def _shape_n(shape) -> str:
+    """Source of the tuple ``(n, *shape)``."""
+    return "(" + ", ".join(["n", *map(str, shape)]) + ("," if not shape else "") + ")"
+
+
+def _run_batch(outs, args) -> list[str]:
+    """Lines that run ``loop`` into fresh outputs or a fitting ``out=``."""
+    onames = [f"o{k}" for k in range(len(outs))]
+    lines = ["if out is None:"]
+    for o, s in zip(onames, outs):
+        lines.append(f"    {o} = empty({_shape_n(s)}, dt)")
+    lines.append(f"    loop({', '.join(args + onames)})")
+    lines.append(
+        f"    return {onames[0]}"
+        if len(outs) == 1
+        else f"    return ({', '.join(onames)},)"
+    )
+    if len(outs) == 1:
+        lines.append(
+            "if type(out) is ndarray and out.dtype is dt and out.shape == "
+            f"{_shape_n(outs[0])} and out.flags.c_contiguous:"
+        )
+        lines.append(f"    loop({', '.join(args)}, out)")
+        lines.append("    return out")
+    return lines
