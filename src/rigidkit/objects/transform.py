@@ -15,8 +15,8 @@ from .._validate import as_array, finite_array, to_numpy
 from ..functional import averaging as _avg
 from ..functional import conversions as _conv
 from ..functional import interpolation as _interp
-from ..functional import se3 as _se3
 from ..functional import screw as _screw
+from ..functional import se3 as _se3
 from ..kernels import se3 as _k
 from ._batch import BatchedArray, batch_shape
 from .group import LieGroup
@@ -198,7 +198,7 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
         the mean twist ``(v, w)`` is below ``tol`` (1e-12; 1e-6 in float32).
         ``weights``, ``axis`` and ``return_info`` as :meth:`Rotation.mean`.
 
-        >>> T = Transform.exp([[1.0, 0.0, 0.0, 0.0, 0.0, 0.1], [-1.0, 0.0, 0.0, 0.0, 0.0, -0.1]])
+        >>> T = Transform.exp([[1.0, 0, 0, 0, 0, 0.1], [-1.0, 0, 0, 0, 0, -0.1]])
         >>> np.round(T.mean(method="geodesic").log(), 12) + 0.0
         array([0., 0., 0., 0., 0., 0.])
         """
@@ -219,7 +219,7 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
     # -- screws (Chasles): see rigidkit.functional.screw ---------------------------------
     @classmethod
     def from_screw(cls, point, direction, pitch, angle):
-        """The screw motion: turn by ``angle`` about an axis, slide ``pitch * angle`` along it.
+        """The screw motion: turn by ``angle`` about an axis, slide ``pitch * angle`` on it.
 
         The axis passes through ``point`` along ``direction`` (any nonzero length;
         turning right-handed about it). ``pitch`` is length per radian; with
