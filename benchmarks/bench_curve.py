@@ -109,12 +109,14 @@ class Group:
         return SE3.make_data(n)
 
 
-def warm_rigidkit(groups, ns=(1, 10, 3)) -> None:
+def warm_rigidkit(groups, ns=(1, 10, 3, 2000)) -> None:
     """Call every rigidkit op, then wait for its compiled loops (the background thread).
 
-    The loops depend on the dtype and broadcast pattern, not on N, so a few small
-    sizes reach every one; later ops (a result fed to another kernel) ask for
-    theirs on the second round.
+    The loops depend on the dtype and broadcast pattern, not on N, so a few sizes
+    reach every one (2,000 also warms an engine that compiles only above 1,000
+    elements); later ops (a result fed to another kernel) ask for theirs on the
+    second round. Each op is called 100 times at one element, so that hot kernels
+    get their one-element loop.
     """
     from rigidkit._engine import numba_backend
 
@@ -128,8 +130,11 @@ def warm_rigidkit(groups, ns=(1, 10, 3)) -> None:
                     fn = r.impls["rigidkit"](d)
                     with warnings.catch_warnings():
                         warnings.simplefilter("ignore")
-                        fn()
-        numba_backend.drain(timeout=900)
+                        for _ in range(100 if d.single else 1):
+                            fn()
+        drain = getattr(numba_backend, "drain", None)
+        if drain is not None:  # an engine without a background loader compiles inline
+            drain(timeout=900)
 
 
 def time_cell(g, r, d, args) -> dict:
