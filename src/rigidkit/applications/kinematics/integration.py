@@ -55,8 +55,7 @@ def _steps(dt, rate, fn):
     """Step durations as an array of the rate's namespace, shape () or (..., N)."""
     n = rate.shape[-2]
     xp = namespace_of(rate)
-    h = finite_array(dt, (), "dt") if not hasattr(dt, "shape") or dt.ndim == 0 else dt
-    h = finite_array(h, (), "dt")
+    h = finite_array(dt, (), "dt")
     if h.ndim and h.shape[-1] != n:
         raise ShapeError(
             f"{fn}: dt has {h.shape[-1]} step times on its last axis, the rates {n} "
