@@ -177,13 +177,15 @@ def euler_rate_inverse_rows(parity, proper, body, t1, t2, t3):
 
 
 @helper
-def lock_distance(d):
-    """Angle (radians) from the middle angle to the nearest lock, from ``D``.
+def lock_sine(d):
+    """``|D|``: the sine of the angle from the middle angle to the nearest lock.
 
-    ``D = cos t2`` (Tait-Bryan) or ``sin t2`` (proper) up to sign; the nearest
-    zero of ``cos`` (``sin``) is ``asin(|D|)`` away, exactly.
+    ``D = cos t2`` (Tait-Bryan) or ``sin t2`` (proper) up to sign, and the nearest
+    zero of ``cos`` (``sin``) is ``asin(|D|)`` away, exactly; callers compare
+    ``|D|`` with ``sin(tol)`` (monotonic, so the same test) and take the
+    ``asin`` only to report a failure, not once per element.
     """
-    return asin(minimum(abs(d), 1.0))
+    return abs(d)
 
 
 @helper
@@ -254,9 +256,10 @@ def rate_matrix_inverse_from_euler(
 ):
     """``E^-1`` (row-major; rows in sequence order, columns x, y, z) and the lock distance.
 
-    The second output is the angle (radians) from the middle angle to the nearest
-    gimbal lock; ``E^-1`` grows as its inverse, and callers reject it below their
-    tolerance. Rows are divided by ``scale`` (rates in the angles' unit).
+    The second output is the sine of the angle from the middle angle to the
+    nearest gimbal lock (:func:`lock_sine`); ``E^-1`` grows as its inverse, and
+    callers reject it below their tolerance. Rows are divided by ``scale`` (rates
+    in the angles' unit).
     """
     t1, t2, t3 = euler_product_order(reverse, a0 * scale, a1 * scale, a2 * scale)
     r = euler_rate_inverse_rows(parity, proper, body, t1, t2, t3)
@@ -271,7 +274,7 @@ def rate_matrix_inverse_from_euler(
         inv * row0[0], inv * row0[1], inv * row0[2],
         inv * row1[0], inv * row1[1], inv * row1[2],
         inv * row2[0], inv * row2[1], inv * row2[2],
-        lock_distance(r[9]),
+        lock_sine(r[9]),
     )  # fmt: skip
 
 
@@ -293,7 +296,7 @@ def omega_from_euler_rates(
 def euler_rates_from_omega(
     e1, e2, parity, proper, reverse, body, scale, a0, a1, a2, wx, wy, wz
 ):
-    """``rates = E^-1 @ omega`` (sequence order) and the lock distance (radians)."""
+    """``rates = E^-1 @ omega`` (sequence order) and :func:`lock_sine`."""
     t1, t2, t3 = euler_product_order(reverse, a0 * scale, a1 * scale, a2 * scale)
     r = euler_rate_inverse_rows(parity, proper, body, t1, t2, t3)
     w = (wx, wy, wz)
@@ -306,7 +309,7 @@ def euler_rates_from_omega(
     u2 = inv * dot3(r[3], r[4], r[5], p0, p1, p2)
     u3 = inv * dot3(r[6], r[7], r[8], p0, p1, p2)
     rev = reverse == 1
-    return (where(rev, u3, u1), u2, where(rev, u1, u3), lock_distance(r[9]))
+    return (where(rev, u3, u1), u2, where(rev, u1, u3), lock_sine(r[9]))
 
 
 @kernel(inputs=[(3,), (3,), (3,)], outputs=[(3,)], params=_PARAMS)
@@ -329,7 +332,7 @@ def alpha_from_euler_accelerations(
 def euler_accelerations_from_alpha(
     e1, e2, parity, proper, reverse, body, scale, a0, a1, a2, r0, r1, r2, ax, ay, az
 ):
-    """Euler second derivatives ``E^-1 (alpha - E' @ rates)`` and the lock distance."""
+    """Euler second derivatives ``E^-1 (alpha - E' @ rates)`` and :func:`lock_sine`."""
     t1, t2, t3 = euler_product_order(reverse, a0 * scale, a1 * scale, a2 * scale)
     u1, u2, u3 = euler_product_order(reverse, r0 * scale, r1 * scale, r2 * scale)
     dc = euler_rate_column_derivatives(parity, proper, body, t1, t2, t3, u1, u2, u3)
@@ -344,4 +347,4 @@ def euler_accelerations_from_alpha(
     g2 = inv * dot3(r[3], r[4], r[5], p0, p1, p2)
     g3 = inv * dot3(r[6], r[7], r[8], p0, p1, p2)
     rev = reverse == 1
-    return (where(rev, g3, g1), g2, where(rev, g1, g3), lock_distance(r[9]))
+    return (where(rev, g3, g1), g2, where(rev, g1, g3), lock_sine(r[9]))

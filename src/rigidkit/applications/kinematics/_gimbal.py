@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..._validate import batch_index, where_text
@@ -16,22 +18,24 @@ def _host(a):
     return np.asarray(a)
 
 
-def check_lock(distance, tol: float, seq, fn: str) -> None:
-    """Raise :class:`GimbalLockError` where ``distance`` (radians) is below ``tol``.
+def check_lock(lock_sine, tol: float, seq, fn: str) -> None:
+    """Raise :class:`GimbalLockError` where the distance to the lock is below ``tol``.
 
-    ``distance`` is the kernel's angle from the middle angle to the lock. Under
-    tracing (``jax.jit``: no concrete values) the check is skipped and the rates
-    come out large but finite.
+    ``lock_sine`` is the kernel's sine of the angle (radians) from the middle
+    angle to the lock; ``asin`` is monotonic, so comparing it with ``sin(tol)``
+    is the same test. Under tracing (``jax.jit``: no concrete values) the check
+    is skipped and the rates come out large but finite.
     """
     try:
-        d = _host(distance)
+        d = _host(lock_sine)
     except Exception:  # a tracer: no concrete value to check
         return
-    if d.size == 0 or float(d.min()) >= tol:
+    limit = math.sin(min(tol, math.pi / 2))
+    if d.size == 0 or float(d.min()) >= limit:
         return
-    bad = d < tol
+    bad = d < limit
     idx = batch_index(bad)
-    dist = float(d[idx]) if idx else float(d)
+    dist = math.asin(min(float(d[idx]), 1.0))
     lock = "0 or pi" if seq.proper else "+-pi/2"
     raise GimbalLockError(
         f"{fn}: gimbal lock in {seq.text!r}: the middle angle {where_text(idx)} is "
