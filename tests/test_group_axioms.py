@@ -218,8 +218,12 @@ def test_identity(G, kind, rng):
     np.testing.assert_array_equal(matrix(Id), eye(G))
     np.testing.assert_array_equal(np.asarray(Id.log()), np.zeros(G.cls.dof))
     M = matrix(X)
-    np.testing.assert_allclose(matrix(X @ Id), M, rtol=0, atol=4 * EPS)
-    np.testing.assert_allclose(matrix(Id @ X), M, rtol=0, atol=4 * EPS)
+    # Composition renormalises the unit part (a quaternion off unit by an ulp moves
+    # by an ulp), so the gap is a few ulp of the entries, which Sim(3)'s scale makes
+    # larger than 1.
+    tol = 4 * EPS * np.maximum(1.0, np.abs(M).max(axis=(-2, -1), keepdims=True))
+    assert np.all(np.abs(matrix(X @ Id) - M) <= tol)
+    assert np.all(np.abs(matrix(Id @ X) - M) <= tol)
     assert G.cls.identity((2, 3)).shape == (2, 3)
 
 

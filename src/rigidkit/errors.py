@@ -143,7 +143,21 @@ class GimbalLockWarning(UserWarning):
     The returned angles still rebuild the rotation; the split between the first
     and third angle is then a convention (the third angle is set to zero at
     exact lock).
+
+    ``index`` is the first locked batch index (``()`` for a single input), as
+    :attr:`RigidkitError.index`; programs read it from ``w.message.index`` of a
+    caught warning ``w``.
+
+    >>> GimbalLockWarning("gimbal lock at batch index (3,)", index=(3,)).index
+    (3,)
     """
+
+    def __init__(self, message="", *, index=None):
+        super().__init__(message)
+        self.index = None if index is None else tuple(int(i) for i in index)
+
+    def __reduce__(self):
+        return (_rebuild_error, (type(self), str(self), self.index))
 
 
 class ConvergenceWarning(UserWarning):

@@ -11,7 +11,9 @@ naming its batch index.
 
 ``quat_multiply``, ``quat_conjugate`` and ``quat_canonical`` are quaternion
 algebra, defined for every quaternion: they take it as it is (no normalisation),
-so the product of unit quaternions stays the bare kernel call.
+so the product of unit quaternions stays the bare kernel call. ``quat_compose``
+is that product as the composition of rotations (``q2`` first), renormalised so
+that long chains of compositions stay unit to a few ulp (``Rotation @`` uses it).
 
 Unchecked variants: ``matrix_from_quat_unchecked``, ``rotvec_from_quat_unchecked``,
 ``mrp_from_quat_unchecked``, ``axis_angle_from_quat_unchecked``,
@@ -60,6 +62,7 @@ __all__ = [
     "quat_normalize",
     "quat_canonical",
     "quat_multiply",
+    "quat_compose",
     "quat_conjugate",
     "quat_apply",
     "quat_angle_between",
@@ -78,6 +81,7 @@ __all__ = [
 ]
 
 quat_multiply = _q.quat_multiply
+quat_compose = _q.quat_compose  # the product as composition of rotations: renormalised
 quat_conjugate = _q.quat_conjugate
 quat_canonical = _q.quat_canonical
 
@@ -103,7 +107,9 @@ def quat_normalize(q, *, what="quaternion"):
         For NaN/inf components or a zero quaternion, naming the batch index.
     """
     q = as_array(q, (4,), what)
-    if type(q) is np.ndarray and q.ndim == 1:  # one element: Python floats, no warnings
+    # One element runs on Python floats, and other namespaces never warn: no errstate
+    # (which torch.compile cannot trace either).
+    if type(q) is not np.ndarray or q.ndim == 1:
         unit, norm = _q.quat_normalize(q)
     else:
         with _quiet():
@@ -211,10 +217,15 @@ def quat_from_matrix(matrix, *, atol=None, orthonormalize=False):
     matrix : array_like, shape (..., 3, 3)
         Active rotation matrices acting on column vectors.
     atol : float, optional
-        Largest accepted ``max(|R^T R - I|, |det R - 1|)``; default 1e-6 (float64)
-        or 1e-4 (float32).
+        Largest accepted distance from SO(3), ``max(|R^T R - I|, |det R - 1|)``
+        (largest entry); default :func:`default_atol`: 1e-5 (float64), 1e-4
+        (float32). A matrix within it is taken as the nearest rotation (its
+        orthogonal polar factor, to ``3/8 atol^2``): matrices written to 6
+        decimals (as in CAD and calibration files; up to 2e-6 off) pass, a
+        scaling by 1 + 1e-5, a shear or a reflection does not.
     orthonormalize : bool
-        Instead of raising, replace each matrix by the nearest rotation (SVD).
+        Instead of raising, replace each matrix by the nearest rotation (SVD),
+        however far it is.
 
     Raises
     ------
@@ -228,7 +239,7 @@ def quat_from_matrix(matrix, *, atol=None, orthonormalize=False):
     if orthonormalize:
         check_finite(m, (3, 3), "rotation matrix")  # before the SVD, which hangs on inf
         m = nearest_rotation_matrix(m)
-    if type(m) is np.ndarray and m.ndim == 2:
+    if type(m) is not np.ndarray or m.ndim == 2:  # no warnings to silence (see above)
         q, err = _mat.quat_from_matrix(m)
     else:
         with _quiet():

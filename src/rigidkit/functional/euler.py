@@ -50,7 +50,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .._engine.namespace import is_float32, namespace_of
-from .._validate import batch_index, finite_array, to_numpy, where_text
+from .._validate import batch_index, checks_now, finite_array, to_numpy, where_text
 from ..errors import EulerSequenceError, GimbalLockWarning
 from ..kernels import euler as _k
 from . import conversions as _conv
@@ -396,21 +396,23 @@ def _warn_if_locked(s: EulerSequence, angles, scale: float) -> None:
         if not near.any():
             return
     else:
+        if not checks_now(mid):  # traced (or Dask) values: no warning; the angles hold
+            return
         xp = namespace_of(mid)
         near = xp.abs(mid - center) > half - tol
         if not bool(xp.any(near)):
             return
     near = to_numpy(near)
     lock = "0 or pi" if s.proper else "+-pi/2"
-    warnings.warn(
+    first = batch_index(near)
+    message = (
         f"gimbal lock in {s.text!r}: {int(near.sum())} of {max(near.size, 1)} middle "
         f"angles are within {tol / scale:.2g} rad of {lock} (first "
-        f"{where_text(batch_index(near))}); there only the sum or difference of the "
+        f"{where_text(first)}); there only the sum or difference of the "
         f"first and third angle is well determined. The angles returned rebuild the "
-        f"rotation; at lock (within {lock_tolerance(dtype):.2g} rad) the third angle is 0.",
-        GimbalLockWarning,
-        stacklevel=_user_stacklevel(),
+        f"rotation; at lock (within {lock_tolerance(dtype):.2g} rad) the third angle is 0."
     )
+    warnings.warn(GimbalLockWarning(message, index=first), stacklevel=_user_stacklevel())
 
 
 _PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))

@@ -141,7 +141,7 @@ def pose_from_matrix(matrix, *, atol=None, orthonormalize=False):
     atol : float, optional
         Tolerance of both checks: the rotation block's
         ``max(|R^T R - I|, |det R - 1|)`` and the bottom row's distance from
-        ``[0, 0, 1]``; default 1e-6 (float64) or 1e-4 (float32).
+        ``[0, 0, 1]``; default 1e-5 (float64) or 1e-4 (float32).
     orthonormalize : bool
         Replace the rotation block by its nearest rotation instead of raising.
         A bad bottom row still raises: that matrix is not a rigid motion at all.

@@ -125,7 +125,7 @@ def pose_from_matrix(M, *, atol=None, orthonormalize=False):
     atol : float, optional
         Largest accepted deviation of the bottom row from ``[0, 0, 0, 1]`` and of
         ``R`` from SO(3) (see :func:`rigidkit.conversions.quat_from_matrix`); default
-        1e-6 (float64) or 1e-4 (float32).
+        1e-5 (float64) or 1e-4 (float32).
     orthonormalize : bool
         Replace the rotation block by the nearest rotation instead of raising. The
         bottom row is still checked.

@@ -126,7 +126,7 @@ def complex_from_matrix(matrix, *, atol=None, orthonormalize=False):
     ``matrix`` (array_like, shape (..., 2, 2)) holds active rotations acting on
     column vectors; the result has shape (..., 2). ``atol`` is the largest accepted
     ``max(|R^T R - I|, |det R - 1|)`` (default
-    :func:`rigidkit._validate.default_atol`: 1e-6 for float64, 1e-4 for float32).
+    :func:`rigidkit._validate.default_atol`: 1e-5 for float64, 1e-4 for float32).
     With ``orthonormalize=True`` the nearest rotation in Frobenius norm is taken
     instead of raising: ``(m00 + m11, m10 - m01)`` normalised.
 

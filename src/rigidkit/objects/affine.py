@@ -24,6 +24,7 @@ from .._validate import (
 from ..errors import NotAffineError
 from ..kernels import homogeneous as _k
 from ._batch import BatchedArray, batch_shape
+from ._frozen import frozen
 from .group import Group
 from .ladder import homogeneous_matrix
 from .projective import Projective
@@ -113,7 +114,7 @@ class Affine(BatchedArray, Group, family="space", rank=3):
             NaN or infinity anywhere.
         NotAffineError
             The bottom row differs from ``[0, 0, 0, 1]`` by more than ``atol``
-            (default 1e-6 for float64, 1e-4 for float32), naming the batch index.
+            (default 1e-5 for float64, 1e-4 for float32), naming the batch index.
         SingularMatrixError
             ``A`` is singular (see the class docs), naming the batch index.
         """
@@ -149,13 +150,13 @@ class Affine(BatchedArray, Group, family="space", rank=3):
     # -- representations ------------------------------------------------------------
     @property
     def matrix(self):
-        """The linear part ``A``, shape (..., 3, 3)."""
-        return self._data[..., :3]
+        """The linear part ``A``, shape (..., 3, 3) (read-only for NumPy storage)."""
+        return frozen(self._data[..., :3])
 
     @property
     def translation(self):
-        """The translation ``t``, shape (..., 3)."""
-        return self._data[..., 3]
+        """The translation ``t``, shape (..., 3) (read-only for NumPy storage)."""
+        return frozen(self._data[..., 3])
 
     def as_matrix(self):
         """Homogeneous matrices ``[[A, t], [0, 1]]``, shape (..., 4, 4)."""

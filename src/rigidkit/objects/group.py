@@ -47,7 +47,9 @@ class Group(ABC):
     - ``a @ b`` of one kind is ``a.compose(b)``;
     - ``a @ b`` of two kinds of one family is composed in the more general kind
       (``Rotation @ Transform`` is a ``Transform``, see :func:`ladder.compose`);
-    - ``a @ p`` for anything else is ``a.apply(p)``;
+    - ``a @ p`` for anything else is ``a.apply(p)``: the last axis of ``p`` is one
+      point or vector, so ``R @ X`` with a (3, 3) array rotates the rows of ``X``
+      (the matrix product is ``R.as_matrix() @ X``);
     - ``array @ a`` is refused with a :class:`TypeError`.
     """
 
@@ -72,20 +74,44 @@ class Group(ABC):
         return self.apply(other)
 
     def compose(self, other, *, out=None):
-        """``self @ other`` (``other`` applied first), for ``other`` of the same kind.
+        """``self @ other`` (``other`` applied first) for a transform ``other``.
 
-        ``out``: a C-contiguous NumPy array of the stored shape (``batch`` plus the
-        shape of one stored element: quaternions (..., 4) for a ``Rotation``, poses
-        (..., 7) for a ``Transform``, ...) that receives the result, which then
-        wraps it (no copy); reusing one saves the page faults of a fresh large
-        output.
+        ``other`` of another kind of the same family composes as with ``@``, in
+        the more general kind (``Transform.compose(Rotation)`` is a ``Transform``).
+
+        ``out``: a C-contiguous NumPy array of the stored shape of the result's
+        kind (``batch`` plus the shape of one stored element: quaternions (..., 4)
+        for a ``Rotation``, poses (..., 7) for a ``Transform``, ...) that receives
+        the result, which then wraps it (no copy); reusing one saves the page
+        faults of a fresh large output. The result then shares ``out``'s memory:
+        write to ``out`` again only once the result is no longer needed.
 
         >>> import rigidkit as rk
         >>> R = rk.Rotation.from_rotvec([0.0, 0.0, 0.5])
         >>> R.compose(R).as_rotvec()
         array([0., 0., 1.])
+        >>> A_T_B = rk.Transform(translation=[1.0, 0.0, 0.0]).compose(R)
+        >>> type(A_T_B).__name__, A_T_B.translation, A_T_B.rotation.as_rotvec()
+        ('Transform', array([1., 0., 0.]), array([0. , 0. , 0.5]))
         """
+        if type(other) is not type(self):
+            if not isinstance(other, Group):
+                raise TypeError(
+                    f"{type(self).__name__}.compose takes a transform, got "
+                    f"{type(other).__name__}; apply it to points with X @ p or X.apply(p)"
+                )
+            if out is None:
+                return ladder.compose(self, other)
+            other = type(self).include(other)  # out= has the stored shape of self's kind
         return self._wrap(self._compose_kernel(self._data, other._data, out=out))
+
+    # ``*`` has no meaning here (STYLE.md: one operator, one meaning); scipy users
+    # write ``R1 * R2`` for what is ``R1 @ R2`` in rigidkit, so the error says so.
+    def __mul__(self, other):
+        raise TypeError(_no_mul(self, other))
+
+    def __rmul__(self, other):
+        raise TypeError(_no_mul(other, self))
 
     def __rmatmul__(self, other):
         name = type(self).__name__
@@ -178,3 +204,13 @@ class LieGroup(Group):
         if side == "left":
             return (self @ other.inv()).log()
         raise ValueError(f"side must be 'right' or 'left', got {side!r}")
+
+
+def _no_mul(a, b) -> str:
+    x = next(c for c in (a, b) if isinstance(c, Group))
+    k = type(x).__name__[0]
+    return (
+        f"{type(a).__name__} * {type(b).__name__} is not defined: compose with @ "
+        f"({k}1 @ {k}2 applies {k}2 first, like scipy's {k}1 * {k}2) and act on points "
+        f"with {k} @ p"
+    )

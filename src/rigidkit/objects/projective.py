@@ -26,6 +26,7 @@ from .._validate import (
 from ..errors import PointAtInfinityError, SingularMatrixError
 from ..kernels import homogeneous as _k
 from ._batch import BatchedArray, batch_shape
+from ._frozen import frozen, owned
 from .group import Group
 from .ladder import homogeneous_matrix
 
@@ -77,7 +78,7 @@ class Projective(BatchedArray, Group, family="space", rank=4):
         check_finite(H, (4, 4), "projective matrix")
         tol = singular_rtol(H.dtype) if rtol is None else rtol
         check_invertible(_k.projective_hadamard_ratio(H), tol, "projective matrix")
-        self._data = H
+        self._data = owned(H, matrix)  # not the caller's array: objects are immutable
 
     @classmethod
     def from_matrix(cls, matrix, *, rtol=None):
@@ -105,8 +106,9 @@ class Projective(BatchedArray, Group, family="space", rank=4):
 
     # -- representations ---------------------------------------------------------------
     def as_matrix(self):
-        """The matrices ``H``, shape (..., 4, 4) (as stored: not normalised)."""
-        return self._data
+        """The matrices ``H``, shape (..., 4, 4) (as stored: not normalised; read-only
+        for NumPy storage)."""
+        return frozen(self._data)
 
     def as_projective(self):
         return self

@@ -25,6 +25,7 @@ from .._engine.namespace import is_numpy, namespace_of
 from .._validate import as_array, check_finite, to_numpy
 from ..functional import quaternion as _fq
 from ._batch import BatchedArray
+from ._frozen import frozen, owned
 from .rotation import Rotation
 
 
@@ -55,7 +56,7 @@ class Quaternion(BatchedArray):
     array(2.)
     """
 
-    __slots__ = ("_q",)
+    __slots__ = ("_q", "_data")  # one array under two names (see _batch)
     _storage = "_q"
     _trail = (4,)
     # NumPy's binary operators defer to ours (ndarray * Quaternion -> __rmul__).
@@ -64,7 +65,8 @@ class Quaternion(BatchedArray):
     def __init__(self, components):
         q = _fq._quat(components, "quaternion components")
         check_finite(q, (4,), "quaternion components")
-        self._q = q
+        # Not the caller's array: objects are immutable.
+        self._q = self._data = owned(q, components)
 
     @classmethod
     def from_parts(cls, scalar, vector):
@@ -109,35 +111,35 @@ class Quaternion(BatchedArray):
     @property
     def w(self):
         """Scalar (real) part, shape (...)."""
-        return self._q[..., 0]
+        return frozen(self._q[..., 0])
 
     @property
     def x(self):
         """Coefficient of ``i``, shape (...)."""
-        return self._q[..., 1]
+        return frozen(self._q[..., 1])
 
     @property
     def y(self):
         """Coefficient of ``j``, shape (...)."""
-        return self._q[..., 2]
+        return frozen(self._q[..., 2])
 
     @property
     def z(self):
         """Coefficient of ``k``, shape (...)."""
-        return self._q[..., 3]
+        return frozen(self._q[..., 3])
 
     scalar = w
 
     @property
     def vector(self):
         """Vector (imaginary) part ``(x, y, z)``, shape (..., 3)."""
-        return self._q[..., 1:]
+        return frozen(self._q[..., 1:])
 
     def __array__(self, dtype=None, copy=None):
         a = to_numpy(self._q)
         if dtype is not None:
             a = a.astype(dtype, copy=False)
-        return a.copy() if copy else a
+        return a.copy() if copy else frozen(a)
 
     # -- algebra ------------------------------------------------------------------
     def __add__(self, other):

@@ -18,6 +18,7 @@ from ..functional import conversions as _conv
 from ..functional import euler
 from ..functional import interpolation as _interp
 from ._batch import BatchedArray, batch_shape
+from ._frozen import frozen
 from .group import LieGroup
 
 __all__ = ["Rotation"]
@@ -42,17 +43,17 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
     ()
     """
 
-    __slots__ = ("_quat",)
+    __slots__ = ("_quat", "_data")  # one array under two names (see _batch)
     _storage = "_quat"
     _trail = (4,)
     _identity = (1.0, 0.0, 0.0, 0.0)
-    _compose_kernel = _conv.quat_multiply
+    _compose_kernel = _conv.quat_compose
     dof, matrix_size, point_dim = 3, 3, 3
 
     def __init__(self, quat, *, _normalized=False):
         if not _normalized:
             quat = _conv.quat_normalize(quat)
-        self._quat = quat
+        self._quat = self._data = quat
 
     # -- construction -------------------------------------------------------
     @classmethod
@@ -74,10 +75,20 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
     def from_matrix(cls, matrix, *, atol=None, orthonormalize=False):
         """From rotation matrices, shape (..., 3, 3), validated.
 
-        Raises :class:`~rigidkit.NotARotationError` (naming the batch index) when a
-        matrix is not a rotation within ``atol``; ``orthonormalize=True`` projects
-        onto the nearest rotation (SVD) instead.
+        ``atol`` is the largest accepted distance from SO(3), ``max(|R^T R - I|,
+        |det R - 1|)``: by default 1e-5 for float64 (so matrices written to 6
+        decimals, up to 2e-6 off, are accepted) and 1e-4 for float32. A matrix
+        within it is projected onto the nearest rotation (to ``3/8 atol^2``); one
+        farther (a scaling by 1 + 1e-5, a shear, a reflection) raises
+        :class:`~rigidkit.NotARotationError` naming the batch index, and NaN or
+        infinity :class:`~rigidkit.NonFiniteError`. ``orthonormalize=True``
+        projects any finite matrix onto its nearest rotation (SVD) instead.
         See :func:`rigidkit.conversions.quat_from_matrix`.
+
+        >>> M = np.round(Rotation.from_rotvec([0.1, 0.2, 0.3]).as_matrix(), 6)
+        >>> R = Rotation.from_matrix(M)                    # 6 decimals: accepted
+        >>> bool(np.abs(R.as_matrix() - M).max() < 1e-6)
+        True
         """
         return cls._wrap(
             _conv.quat_from_matrix(matrix, atol=atol, orthonormalize=orthonormalize)
@@ -134,8 +145,17 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
 
     # -- representations ------------------------------------------------------
     def as_quat(self, *, scalar_first=True, canonical=False):
-        """Unit quaternions, shape (..., 4); ``canonical=True`` gives ``w >= 0``."""
-        q = _conv.quat_canonical(self._quat) if canonical else self._quat
+        """Unit quaternions, shape (..., 4); ``canonical=True`` gives ``w >= 0``.
+
+        A NumPy result of the stored quaternions is a read-only view (objects are
+        immutable; ``.copy()`` it to edit), see :mod:`rigidkit.objects._frozen`.
+        """
+        if canonical:
+            q = _conv.quat_canonical(self._quat)
+        elif scalar_first:
+            return frozen(self._quat)
+        else:
+            q = self._quat
         return q if scalar_first else _conv.quat_xyzw_from_wxyz(q)
 
     def as_matrix(self, *, out=None):
@@ -193,7 +213,23 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
     # ``R1 @ R2`` composes (``R2`` first), ``R @ v`` rotates vectors and ``compose``
     # takes an ``out=`` buffer: Group, with the Hamilton product as _compose_kernel.
     def apply(self, vectors, *, out=None):
-        """Rotate vectors, shape (..., 3) broadcasting with the rotation's shape."""
+        """Rotate vectors, shape (..., 3) broadcasting with the rotation's shape.
+
+        ``R @ v`` is this. The last axis is the vector, so a (3, 3) array ``X`` is
+        three vectors, its rows: ``R @ X == X @ R.as_matrix().T``. The matrix
+        product, which rotates the columns, is spelled ``R.as_matrix() @ X``.
+
+        >>> R = Rotation.from_rotvec([0.0, 0.0, np.pi / 2])
+        >>> X = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]) + 1.0
+        >>> np.round(R @ X, 12) + 0.0                  # rows rotated
+        array([[-1.,  2.,  1.],
+               [-2.,  1.,  1.],
+               [-1.,  1.,  2.]])
+        >>> np.round(R.as_matrix() @ X, 12) + 0.0      # columns rotated
+        array([[-1., -2., -1.],
+               [ 2.,  1.,  1.],
+               [ 1.,  1.,  2.]])
+        """
         v = as_array(vectors, (3,), "vectors")
         return _conv.quat_apply_unchecked(self._quat, v, out=out)
 

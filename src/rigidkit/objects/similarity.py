@@ -23,6 +23,7 @@ from ..functional import conversions as _conv
 from ..functional import sim3 as _fsim3
 from ..kernels import sim3 as _k
 from ._batch import BatchedArray, batch_shape
+from ._frozen import frozen
 from .affine import Affine
 from .group import LieGroup
 from .projective import Projective
@@ -96,7 +97,7 @@ class Similarity(BatchedArray, LieGroup, family="space", rank=2):
         Parameters
         ----------
         atol : float, optional
-            Tolerance of the bottom row and of ``A / s`` from SO(3); default 1e-6
+            Tolerance of the bottom row and of ``A / s`` from SO(3); default 1e-5
             (float64) or 1e-4 (float32), as :meth:`Rotation.from_matrix`.
 
         Raises
@@ -174,13 +175,13 @@ class Similarity(BatchedArray, LieGroup, family="space", rank=2):
 
     @property
     def translation(self):
-        """The translation ``t``, shape (..., 3)."""
-        return self._data[..., 4:7]
+        """The translation ``t``, shape (..., 3) (read-only for NumPy storage)."""
+        return frozen(self._data[..., 4:7])
 
     @property
     def scale(self):
-        """The scale ``s > 0``, shape (...)."""
-        return self._data[..., 7]
+        """The scale ``s > 0``, shape (...) (read-only for NumPy storage)."""
+        return frozen(self._data[..., 7])
 
     def as_matrix(self):
         """Homogeneous matrices ``[[s R, t], [0, 1]]``, shape (..., 4, 4)."""

@@ -19,6 +19,7 @@ from ..functional import screw as _screw
 from ..functional import se3 as _se3
 from ..kernels import se3 as _k
 from ._batch import BatchedArray, batch_shape
+from ._frozen import frozen
 from .group import LieGroup
 from .rotation import Rotation
 
@@ -58,7 +59,7 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
            [ 0.,  0.,  0.,  1.]])
     """
 
-    __slots__ = ("_pose",)
+    __slots__ = ("_pose", "_data")  # one array under two names (see _batch)
     _storage = "_pose"
     _trail = (7,)
     _identity = (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)  # (w, x, y, z, tx, ty, tz)
@@ -73,7 +74,7 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
         if translation is not None:
             translation = finite_array(translation, (3,), "translation")
         if rotation is None and translation is None:
-            self._pose = self._filled(self._identity, ())
+            self._pose = self._data = self._filled(self._identity, ())
             return
         if rotation is None:
             quat = _constant_like(translation, [1.0, 0.0, 0.0, 0.0])
@@ -81,7 +82,7 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
             quat = rotation._quat
         if translation is None:
             translation = _constant_like(quat, [0.0, 0.0, 0.0])
-        self._pose = _k.pose_from_quat_translation(quat, translation)
+        self._pose = self._data = _k.pose_from_quat_translation(quat, translation)
 
     # -- construction ------------------------------------------------------------------
     @classmethod
@@ -151,8 +152,8 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
 
     @property
     def translation(self):
-        """The translation part ``t``, shape (..., 3)."""
-        return self._pose[..., 4:]
+        """The translation part ``t``, shape (..., 3) (read-only for NumPy storage)."""
+        return frozen(self._pose[..., 4:])
 
     # -- group operations --------------------------------------------------------------
     # ``T1 @ T2`` composes (``T2`` first), ``T @ p`` moves points and ``compose`` takes
@@ -163,7 +164,12 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
         return cls(rotation=x)
 
     def apply(self, points, *, out=None):
-        """Move points: ``R p + t``, shape (..., 3) broadcasting with the batch shape."""
+        """Move points: ``R p + t``, shape (..., 3) broadcasting with the batch shape.
+
+        ``T @ p`` is this. The last axis is the point, so a (3, 3) array holds three
+        points, its rows (not the columns of a matrix product: for those write
+        ``(T.as_matrix() @ [[X], [1, 1, 1]])[:3]``).
+        """
         return _k.pose_apply(self._pose, as_array(points, (3,), "points"), out=out)
 
     def inv(self):

@@ -15,6 +15,7 @@ from .._validate import as_array, finite_array, to_numpy
 from ..functional import se2 as _se2
 from ..kernels import se2 as _k
 from ._batch import BatchedArray, batch_shape
+from ._frozen import frozen
 from .group import LieGroup
 from .rotation2d import Rotation2D
 
@@ -122,8 +123,8 @@ class Transform2D(BatchedArray, LieGroup, family="plane", rank=1):
     # -- parts and representations ---------------------------------------------
     @property
     def translation(self):
-        """The translation part ``t``, shape (..., 2)."""
-        return self._data[..., 2:]
+        """The translation part ``t``, shape (..., 2) (read-only for NumPy storage)."""
+        return frozen(self._data[..., 2:])
 
     @property
     def rotation(self) -> Rotation2D:

@@ -130,7 +130,7 @@ def build_parser(run_convert) -> argparse.ArgumentParser:
         "--orthonormalize",
         action="store_true",
         help="matrix input: use the nearest rotation (SVD) instead of rejecting a matrix "
-        "that is not a rotation within 1e-6 (e.g. one typed with few digits)",
+        "that is not a rotation within 1e-5 (e.g. one typed with few digits)",
     )
     convert.add_argument("-i", "--input", metavar="IN", help="batch input: .npy, .csv or -")
     convert.add_argument(
