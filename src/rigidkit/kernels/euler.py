@@ -132,7 +132,11 @@ def euler_from_quat(e1, e2, parity, proper, reverse, scale, tol, w, x, y, z):
     written first and makes the one written third 0 (``t3`` for intrinsic, ``t1``
     for extrinsic sequences; then ``z_s`` is a multiple of ``z_b`` or of its
     conjugate). We return it whenever the nearest such decomposition is within
-    ``tol`` (radians) of ``q``. That nearest one replaces ``z_s`` by its
+    ``tol`` (radians) of ``q`` and the middle angle is within ``8 tol`` of the lock
+    (``|z_s|^2 <= 16 tol^2 (|z1|^2 + |z2|^2)``): a rotation whose third angle is
+    merely 0 away from the lock (the identity of a Tait-Bryan sequence) keeps the
+    exact split, whose derivatives are right, and rounding residues (a few eps)
+    still take the lock convention. That nearest one replaces ``z_s`` by its
     projection on the ray it must lie on, which makes the angle ``t0`` between
     them (``t0`` = the angle written third). With ``W = X + iY`` the product whose
     argument is ``t0`` (``|W| = |z1| |z2|``) the projection is ``|z_s| cos t0 =
@@ -147,8 +151,8 @@ def euler_from_quat(e1, e2, parity, proper, reverse, scale, tol, w, x, y, z):
     angles). The caller's ``tol`` is 2 eps of the input dtype (see
     :func:`rigidkit.euler.lock_tolerance`): a middle angle ``d`` from the lock has
     ``|z_s| / |q| = sin(d / 2)`` (Tait-Bryan: in the proper form), so the rotation
-    moves by ``d |sin t0|`` or less; at ``d = 1e-12`` the exact split is kept
-    unless ``|sin t0| < 4.4e-4`` (where it is itself uncertain by that much).
+    moves by ``d |sin t0|`` or less; at ``d = 1e-12`` (beyond ``8 tol = 3.6e-15``)
+    the exact split is kept.
 
     First and third angles are in (-pi, pi]; the middle in [0, pi] (proper) or
     [-pi/2, pi/2] (Tait-Bryan). The formulas are homogeneous of degree 0 in
@@ -188,12 +192,17 @@ def euler_from_quat(e1, e2, parity, proper, reverse, scale, tol, w, x, y, z):
     f_y = where(rev, m_y, p_y)
     t_x = where(rev, p_x, m_x)
     t_y = where(rev, p_y, m_y)
-    # Lock test (docstring): the rotation moves by at most tol when the angle
-    # written third is set to 0 and z_s projected.
+    # Lock test (docstring): the middle angle d is within 8 tol of the lock
+    # (sin(d/2)^2 = |z_s|^2 / (|z1|^2 + |z2|^2) <= 16 tol^2), and the rotation
+    # moves by at most tol when the angle written third is set to 0 and z_s
+    # projected. Without the first test a third angle merely 0 would take the lock
+    # branch, exact in value but with the lock's derivatives (third angle constant).
     small1 = n1sq < n2sq
+    n_small = where(small1, n1sq, n2sq)
+    n_big = where(small1, n2sq, n1sq)
     outside = minimum(t_x, 0.0)
-    lock = t_y * t_y + outside * outside <= (0.25 * tol * tol) * (n1sq + n2sq) * where(
-        small1, n2sq, n1sq
+    lock = (n_small <= (16.0 * tol * tol) * (n1sq + n2sq)) & (
+        t_y * t_y + outside * outside <= (0.25 * tol * tol) * (n1sq + n2sq) * n_big
     )
     # At lock the angle written first is arg(z_b^2) (intrinsic), or for extrinsic
     # sequences arg(z1^2) (z2 small) or arg(conj(z2)^2) (z1 small), times sign3.
@@ -201,13 +210,15 @@ def euler_from_quat(e1, e2, parity, proper, reverse, scale, tol, w, x, y, z):
     sq_x = where(small1, cc - dd, aa - bb)
     sq_y = g * 2.0 * where(small1, c * d, a * b)
     first = angle_of(where(lock, sq_x, f_x), where(lock, sq_y, f_y))
-    third = where(lock, 0.0, angle_of(t_x, t_y))
+    # The branch not taken is evaluated at a safe argument: at lock t = 0 (z_s = 0),
+    # where atan2's derivative is 0/0, NaN in every gradient even through where().
+    third = where(lock, 0.0, angle_of(where(lock, 1.0, t_x), where(lock, 0.0, t_y)))
     # Middle angle: the argument of a vector parallel to (|z1|, |z2|) (proper,
     # doubled), here times |z1|, or of (|z1| |z2|, 2 (w v2 + v1 v3)) (Tait-Bryan).
     # At lock |z_s| is replaced by the projection X / |z_b|: (|z1|, |z2|) |z_b|
     # becomes (|z1|^2, X) or (X, |z2|^2), and |z1| |z2| becomes X. One sqrt.
     proj = where(t_x > 0.0, t_x, 0.0)  # +0.0 also for t_x = -0.0
-    n12 = sqrt(n1sq * n2sq)
+    n12 = sqrt(where(lock, 1.0, n1sq * n2sq))  # (not used at lock, where it can be 0)
     mid_c = where(is_proper, where(lock & small1, proj, n1sq), where(lock, proj, n12))
     mid_s = where(
         is_proper,
