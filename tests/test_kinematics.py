@@ -360,3 +360,43 @@ def test_planar_twists(rng):
         )
     with pytest.raises(rk.NotARigidTransformError):
         P.twist_from_derivative(2 * T0, fd(T), frame="world")
+
+
+# -- the kernels' bindings agree (kernels with static parameters; tests/test_engine.py
+# covers the others) ----------------------------------------------------------------------
+
+
+def _param_kernels():
+    from rigidkit.functional.euler import parse_sequence
+    from rigidkit.kernels import kinematics as k1
+    from rigidkit.kernels import kinematics_euler as k2
+    from rigidkit.kernels import kinematics_integration as k3
+    from rigidkit.kernels import kinematics_planar as k4
+
+    cases = []
+    for mod in (k1, k3, k4):
+        for obj in vars(mod).values():
+            if getattr(obj, "params", None) in (("body",), ("inverse",)):
+                cases += [(obj, (b,)) for b in (0, 1)]
+    for obj in vars(k2).values():
+        if getattr(obj, "params", ()) and obj.params[0] == "e1":
+            for seq in ("ZYX", "xzx", "YXZ", "zyz"):
+                for b in (0, 1):
+                    cases.append((obj, (*parse_sequence(seq).params, b, 1.0)))
+    return cases
+
+
+def test_parameterised_kernels_agree_on_every_binding(rng):
+    for kern, params in _param_kernels():
+        n = 1500  # above the numba threshold
+        arrays = [rng.standard_normal((n,) + s) for s in kern.inputs]
+        xp = kern(*params, *arrays, backend="xp")
+        nb = kern(*params, *arrays, backend="numba")
+        one = kern(*params, *(a[7] for a in arrays), backend="python")
+        xp = xp if isinstance(xp, tuple) else (xp,)
+        nb = nb if isinstance(nb, tuple) else (nb,)
+        one = one if isinstance(one, tuple) else (one,)
+        for a, b, c in zip(xp, nb, one):
+            scale = np.maximum(1.0, np.abs(a))
+            assert np.abs((a - b) / scale).max() < 1e-13, (kern.name, params)
+            assert np.abs((a[7] - c) / scale[7]).max() < 1e-13, (kern.name, params)
