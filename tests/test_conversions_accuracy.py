@@ -654,14 +654,17 @@ def helper_kernels(tmp_path_factory):
     """
     import importlib.util
 
+    names = [
+        name
+        for name, (_, arity) in COEF_REFS.items()
+        if name in _coef_helpers() and arity == 1
+    ]
     lines = [
         "from rigidkit._engine import kernel",
-        "import rigidkit.kernels.coefficients",
+        f"from rigidkit.kernels.coefficients import {', '.join(names)}",
         "",
     ]
-    for name, (_, arity) in COEF_REFS.items():
-        if name not in _coef_helpers() or arity != 1:
-            continue
+    for name in names:
         lines += [
             "",
             "@kernel(inputs=[()], outputs=[()])",

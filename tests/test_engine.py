@@ -731,3 +731,159 @@ def test_disable_numba_env_var():
     )
     assert res.returncode == 0, res.stderr
     assert res.stdout.strip() == "ok"
+
+
+# -- helpers resolve by module ---------------------------------------------------------
+def _load(tmp_path, name, source):
+    """Import ``source`` as module ``name`` from a real file (numba reads the source)."""
+    import importlib.util
+
+    path = tmp_path / f"{name}.py"
+    path.write_text(textwrap.dedent(source))
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_a_second_helper_of_one_name_is_refused(tmp_path):
+    """In one module a second ``scale`` would silently replace the first: refused."""
+    twice = """
+        from rigidkit._engine import helper
+
+        @helper
+        def scale(x):
+            return 2.0 * x
+
+        @helper
+        def scale(x):
+            return 3.0 * x
+    """
+    with pytest.raises(NameError, match="already has a helper or kernel 'scale'"):
+        _load(tmp_path, "rigidkit_test_twice", twice)
+    shadow = """
+        from rigidkit._engine import helper
+        from rigidkit.kernels.coefficients import sinc
+
+        @helper
+        def sinc(x):
+            return x
+    """
+    with pytest.raises(NameError, match="already has a helper or kernel 'sinc'"):
+        _load(tmp_path, "rigidkit_test_shadow", shadow)
+
+
+def test_helpers_of_one_name_in_two_modules(tmp_path):
+    """No global registry: each module's kernel calls its own ``scale``, everywhere."""
+    template = """
+        from rigidkit._engine import helper, kernel
+
+        @helper
+        def scale(x):
+            return {factor} * x
+
+        @kernel(inputs=[()], outputs=[()])
+        def scaled(x):
+            return (scale(x) + 1.0,)
+    """
+    a = _load(tmp_path, "rigidkit_test_mod_a", template.format(factor=2.0))
+    b = _load(tmp_path, "rigidkit_test_mod_b", template.format(factor=3.0))
+    x = np.linspace(-1.0, 1.0, 1500)
+    for backend in ("numba", "xp"):
+        np.testing.assert_array_equal(a.scaled(x, backend=backend), 2.0 * x + 1.0)
+        np.testing.assert_array_equal(b.scaled(x, backend=backend), 3.0 * x + 1.0)
+    assert (a.scaled.python(0.25), b.scaled.python(0.25)) == ((1.5,), (1.75,))
+    assert (float(a.scaled(np.array(0.25))), float(b.scaled(np.array(0.25)))) == (1.5, 1.75)
+    np.testing.assert_array_equal(b.scaled(torch.from_numpy(x)).numpy(), 3.0 * x + 1.0)
+    s = sp.Symbol("s")
+    assert a.scaled.sympy(s)[0] == 2.0 * s + 1.0
+    assert b.scaled.sympy(s)[0] == 3.0 * s + 1.0
+
+
+def test_a_kernel_calls_kernels_and_helpers_it_imports(tmp_path):
+    """Kernels of other modules are called like helpers: ``q1* q2`` on every binding."""
+    src = """
+        from rigidkit._engine import kernel
+        from rigidkit.kernels.quaternion import quat_conjugate, quat_multiply
+
+        @kernel(inputs=[(4,), (4,)], outputs=[(4,)])
+        def relative(w1, x1, y1, z1, w2, x2, y2, z2):
+            w, x, y, z = quat_conjugate(w1, x1, y1, z1)
+            return quat_multiply(w, x, y, z, w2, x2, y2, z2)
+    """
+    m = _load(tmp_path, "rigidkit_test_calls", src)
+    names = [d.name for d in m.relative.dependencies()]
+    assert sorted(names) == ["quat_conjugate", "quat_multiply"]
+    rng = np.random.default_rng(12)
+    q1, q2 = rng.standard_normal((2, 1500, 4))
+    w1, x1, y1, z1 = q1.T
+    w2, x2, y2, z2 = q2.T
+    # the Hamilton product of (w1, -v1) and (w2, v2), written out by hand
+    want = np.stack(
+        [
+            w1 * w2 + x1 * x2 + y1 * y2 + z1 * z2,
+            w1 * x2 - x1 * w2 - y1 * z2 + z1 * y2,
+            w1 * y2 + x1 * z2 - y1 * w2 - z1 * x2,
+            w1 * z2 - x1 * y2 + y1 * x2 - z1 * w2,
+        ],
+        axis=-1,
+    )
+    for backend in ("numba", "xp"):
+        np.testing.assert_allclose(m.relative(q1, q2, backend=backend), want, atol=1e-15)
+    for i in range(3):
+        got = m.relative.python(*q1[i], *q2[i])
+        np.testing.assert_allclose(got, want[i], atol=1e-15)
+
+
+def test_ambiguous_or_unknown_callees_are_refused(tmp_path):
+    """Two callees of one name (one numba module holds them all), an alias, a non-helper."""
+    _load(
+        tmp_path,
+        "rigidkit_test_dup_a",
+        """
+        from rigidkit._engine import helper
+
+        @helper
+        def scale(x):
+            return 2.0 * x
+
+        @helper
+        def twice(x):
+            return scale(x)
+        """,
+    )
+    clash = """
+        from rigidkit._engine import helper, kernel
+        from rigidkit_test_dup_a import twice
+
+        @helper
+        def scale(x):
+            return 3.0 * x
+
+        @kernel(inputs=[()], outputs=[()])
+        def both(x):
+            return (twice(x) + scale(x),)
+    """
+    with pytest.raises(NameError, match="two functions named 'scale'"):
+        _load(tmp_path, "rigidkit_test_dup_b", clash)
+    alias = """
+        from rigidkit._engine import kernel
+        from rigidkit.kernels.coefficients import sinc as sine_cardinal
+
+        @kernel(inputs=[()], outputs=[()])
+        def k(x):
+            return (sine_cardinal(x),)
+    """
+    with pytest.raises(NameError, match="calls 'sinc' as 'sine_cardinal'"):
+        _load(tmp_path, "rigidkit_test_alias", alias)
+    unknown = """
+        from rigidkit._engine import kernel
+        import math
+
+        @kernel(inputs=[()], outputs=[()])
+        def k(x):
+            return (math.sin(x),)
+    """
+    with pytest.raises(NameError, match="neither a primitive nor a helper"):
+        _load(tmp_path, "rigidkit_test_unknown", unknown)

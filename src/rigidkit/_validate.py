@@ -26,8 +26,103 @@ import math
 
 import numpy as np
 
-from ._engine.namespace import is_float32, is_numpy, namespace_of
+from ._engine import dask_backend
+from ._engine.namespace import is_float32, is_numpy, is_torch, namespace_of
 from .errors import NonFiniteError, NotARotationError, ShapeError, SingularMatrixError
+
+# -- when values can be checked: concreteness and the validation switch ---------------
+
+#: Whether checks that read values run (shape checks always do); see
+#: :class:`set_validation`. One module global: the hot path reads it in ~10 ns.
+_ENABLED = True
+
+
+class set_validation:
+    """Turn the checks that read values on or off, for the process or a block.
+
+    ``rk.set_validation(False)`` skips every check that needs the values of an
+    array (finiteness, unit norms, orthonormality, ...; shapes are still checked),
+    so no public op ever reads a device array back to the host: bad input then
+    yields NaN or a wrong result instead of an error. Called plainly it sets the
+    switch; as a context manager it restores the previous state on exit (like
+    ``torch.set_grad_enabled``). The switch is process-wide, not per thread.
+
+    >>> import numpy as np
+    >>> import rigidkit as rk
+    >>> with rk.set_validation(False):
+    ...     q = rk.conversions.quat_normalize(np.array([0.0, 0.0, 0.0, 0.0]))
+    >>> bool(np.isnan(q).all())
+    True
+    """
+
+    def __init__(self, enabled: bool):
+        global _ENABLED
+        self.prev = _ENABLED
+        _ENABLED = bool(enabled)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        global _ENABLED
+        _ENABLED = self.prev
+
+
+def validation_enabled() -> bool:
+    """Whether checks that read values are on (see :class:`set_validation`)."""
+    return _ENABLED
+
+
+def concrete(x) -> bool:
+    """Whether the values of ``x`` can be read now, without tracing or computing.
+
+    False for a JAX tracer (under ``jax.jit``, ``vmap``, ``grad``...), a torch tensor
+    while ``torch.compile`` traces or inside ``torch.func`` transforms (a wrapped
+    tensor), and a Dask array (whose values exist only once computed; its checks
+    are deferred to compute time instead, see :func:`checks_now`). True for NumPy
+    arrays, Python numbers and other concrete arrays. NumPy input costs one type
+    test; jax and torch are never imported here unless ``x`` is one of theirs.
+    """
+    t = type(x)
+    if t in _CONCRETE_TYPES:
+        return True
+    module = t.__module__
+    if module.startswith("jax"):  # jax.Array is jaxlib's; tracers are jax._src's
+        return not isinstance(x, _jax_tracer())
+    if is_torch(x):
+        import torch
+
+        if torch.compiler.is_compiling():
+            return False
+        return not torch._C._functorch.is_functorch_wrapped_tensor(x)
+    return not module.startswith("dask")
+
+
+_CONCRETE_TYPES = frozenset(
+    (np.ndarray, float, int, bool, np.bool_, np.float64, list, tuple)
+)
+_NDARRAY = np.ndarray
+_JAX_TRACER = None
+
+
+def _jax_tracer():
+    global _JAX_TRACER
+    if _JAX_TRACER is None:
+        import jax  # already imported: x is a jax object
+
+        _JAX_TRACER = jax.core.Tracer
+    return _JAX_TRACER
+
+
+def checks_now(x) -> bool:
+    """Whether a check that reads ``x``'s values runs now (concrete, switch on)."""
+    return _ENABLED and (type(x) is _NDARRAY or concrete(x))
+
+
+def _deferred(x) -> bool:
+    """Whether a check of ``x`` is deferred to compute time (a Dask array, switch on)."""
+    return _ENABLED and type(x) is not np.ndarray and dask_backend.is_dask(x)
+
 
 # -- arrays, masks and batch indices ----------------------------------------------------
 
@@ -53,18 +148,33 @@ def where_text(index: tuple) -> str:
 
 
 def any_true(mask) -> bool:
-    """Whether any entry of a boolean array (of any namespace, or a bool) is true."""
+    """Whether any entry of a boolean array (of any namespace, or a bool) is true.
+
+    The question of every "is something wrong?" test: where the values cannot be
+    read (see :func:`concrete`) or validation is off, nothing is found (False);
+    for a Dask mask the answer is True ("maybe"), so that the error branch runs
+    and its checks defer themselves to compute time.
+    """
     if isinstance(mask, (np.ndarray, np.bool_)):
-        return bool(mask.any())
+        return _ENABLED and bool(mask.any())
+    if not checks_now(mask):
+        return _deferred(mask)
     if getattr(mask, "ndim", 0) == 0:
         return bool(mask)
     return bool(namespace_of(mask).any(mask))
 
 
 def all_true(mask) -> bool:
-    """Whether every entry of a boolean array (of any namespace, or a bool) is true."""
+    """Whether every entry of a boolean array (of any namespace, or a bool) is true.
+
+    The question of every "is all well?" test: True where the values cannot be
+    read or validation is off, False ("maybe not") for a Dask mask (see
+    :func:`any_true`).
+    """
     if isinstance(mask, (np.ndarray, np.bool_)):
-        return bool(mask.all())
+        return not _ENABLED or bool(mask.all())
+    if not checks_now(mask):
+        return not _deferred(mask)
     if getattr(mask, "ndim", 0) == 0:
         return bool(mask)
     return bool(namespace_of(mask).all(mask))
@@ -79,7 +189,13 @@ def raise_where(bad, error, message, *, value=None) -> None:
     ``"axis is zero at batch index (1, 2)"``) and ``{value}`` the offending element
     of the array ``value`` (a float, or a list for an element with axes of its
     own). A callable ``message`` receives the index and returns the whole text.
+
+    On a Dask mask the check runs per chunk at compute time (the error names the
+    global batch index); where values cannot be read it is skipped.
     """
+    if _deferred(bad):
+        dask_backend.defer(_raise_where_numpy, (bad, value), (error, message))
+        return
     if not any_true(bad):
         return
     idx = batch_index(bad)
@@ -92,9 +208,15 @@ def raise_where(bad, error, message, *, value=None) -> None:
     raise error(message.format(where=where_text(idx), value=found), index=idx)
 
 
+def _raise_where_numpy(bad, value, error, message):
+    raise_where(bad, error, message, value=value)
+
+
 def raise_unless(ok, error, message) -> None:
     """:func:`raise_where` at the first False of ``ok`` (a mask or a bool)."""
-    if not all_true(ok):
+    if _deferred(ok):
+        raise_where(~ok, error, message)
+    elif not all_true(ok):
         raise_where(~np.asarray(to_numpy(ok)), error, message)
 
 
@@ -114,7 +236,11 @@ def shape_error(what: str, shape: tuple, trail: tuple) -> ShapeError:
 def as_array(x, trail: tuple, what: str):
     """``x`` as an array of its own namespace (NumPy for lists), shape-checked."""
     if type(x) is not np.ndarray and is_numpy(namespace_of(x)):
-        x = np.asarray(x)
+        if dask_backend.is_dask(x):  # kept lazy: the engine maps kernels over chunks
+            if x.dtype.kind not in "fiu":
+                raise ShapeError(f"{what}: expected real numbers, got dtype {x.dtype}")
+        else:
+            x = np.asarray(x)
     if isinstance(x, np.ndarray) and x.dtype.kind not in "fiu":
         raise ShapeError(f"{what}: expected real numbers, got dtype {x.dtype}")
     nt = len(trail)
@@ -126,6 +252,8 @@ def as_array(x, trail: tuple, what: str):
 
 def check_finite(x, trail: tuple, what: str) -> None:
     """Raise :class:`NonFiniteError` if any component of ``x`` is NaN or infinite."""
+    if not _ENABLED:
+        return
     if isinstance(x, np.ndarray):
         if x.dtype.kind != "f":
             return
@@ -139,6 +267,10 @@ def check_finite(x, trail: tuple, what: str) -> None:
         if math.isfinite(x):
             return
         bad = np.asarray(True)
+    elif not checks_now(x):
+        if _deferred(x):
+            dask_backend.defer(_check_finite_numpy, (x,), (trail, what), (len(trail),))
+        return
     else:
         xp = namespace_of(x)
         fin = xp.isfinite(x)
@@ -148,6 +280,10 @@ def check_finite(x, trail: tuple, what: str) -> None:
     if trail:
         bad = bad.reshape(bad.shape[: bad.ndim - len(trail)] + (-1,)).any(axis=-1)
     raise_where(bad, NonFiniteError, f"{what} contains NaN or infinity {{where}}")
+
+
+def _check_finite_numpy(x, trail, what):
+    check_finite(x, trail, what)
 
 
 def finite_array(x, trail: tuple, what: str):
@@ -168,17 +304,23 @@ def as_float(a):
 
 
 def default_atol(dtype) -> float:
-    """Tolerance of group membership: 1e-6 for float64, 1e-4 for float32.
+    """Tolerance of group membership: 1e-5 for float64, 1e-4 for float32.
 
     The largest accepted ``max(|R^T R - I|, |det R - 1|)`` of a rotation (block),
-    and deviation of a homogeneous matrix's bottom row from ``[0, ..., 0, 1]``:
-    loose enough for matrices written to a few digits or computed in float32 (whose
-    rounding alone reaches ~1e-6), tight enough to refuse a scaling by 1 + 1e-5.
+    and deviation of a homogeneous matrix's bottom row from ``[0, ..., 0, 1]``.
+    Loose enough for rotation matrices written to 6 decimals, as CAD and
+    calibration files have them (measured over 200,000 random rotations: up to
+    1.9e-6, and a quarter of them above the former 1e-6), or computed in float32
+    (whose rounding alone reaches ~1e-6); such a matrix is then projected onto the
+    nearest rotation (see :func:`rigidkit.conversions.quat_from_matrix`). Tight
+    enough to refuse a scaling by 1 + 1e-5 (``det - 1 = 3e-5``), and every shear,
+    reflection or scaling that is not rounding noise. With 5 decimals (up to
+    1.9e-5) pass ``atol=`` or ``orthonormalize=True``.
 
     >>> default_atol(np.float64), default_atol(np.float32)
-    (1e-06, 0.0001)
+    (1e-05, 0.0001)
     """
-    return 1e-4 if is_float32(dtype) else 1e-6
+    return 1e-4 if is_float32(dtype) else 1e-5
 
 
 def singular_rtol(dtype) -> float:
@@ -217,6 +359,8 @@ def check_bottom_row(M, atol, kind, error, *, what="homogeneous matrix") -> None
     """
     n = M.shape[-1]
     tol = default_atol(M.dtype) if atol is None else atol
+    if type(M) is not np.ndarray and not checks_now(M) and not _deferred(M):
+        return
     if isinstance(M, np.ndarray) and M.ndim == 2:
         # One matrix: a few float comparisons cost less than one ufunc call.
         *zeros, one = M[n - 1].tolist()
@@ -260,6 +404,9 @@ def check_rotation(block, err, atol, *, what="matrix") -> None:
     saying why (a reflection, a scaling, a shear).
     """
     tol = default_atol(block.dtype) if atol is None else atol
+    if _deferred(err):  # per chunk at compute time: the message reads the block
+        dask_backend.defer(_check_rotation_numpy, (err, block), (tol, what))
+        return
     ok = err <= tol
     if all_true(ok):
         return
@@ -273,6 +420,10 @@ def check_rotation(block, err, atol, *, what="matrix") -> None:
         )
 
     raise_unless(ok, NotARotationError, message)
+
+
+def _check_rotation_numpy(err, block, tol, what):
+    check_rotation(block, err, tol, what=what)
 
 
 def check_rotation_2d(block, norm, err, *, atol, orthonormalize, what="matrix") -> None:

@@ -1,8 +1,9 @@
 """Kernels: write a formula once, evaluate it on every backend.
 
 A kernel is a plain Python function of scalar components that returns a tuple of
-scalar components. It may call the primitives of :mod:`.primitives` and other
-functions registered with :func:`helper`. :func:`kernel` declares the trailing
+scalar components. It may call the primitives of :mod:`.primitives`, and the
+:func:`helper` functions and other kernels that its module defines or imports
+(resolved by name in that module, at definition). :func:`kernel` declares the trailing
 shape of each array input and output, and turns the function into a
 :class:`Kernel` that takes and returns arrays batched over leading axes
 (broadcasting like NumPy):
@@ -35,11 +36,20 @@ import math
 import os
 import sys
 import types
+import weakref
 
 import numpy as np
 
-from . import numba_backend
-from .namespace import device_of, float_dtype_of, is_numpy, namespace_of
+from . import dask_backend, numba_backend
+from .namespace import (
+    _torch_namespace,
+    device_of,
+    float_dtype_of,
+    is_half,
+    is_numpy,
+    namespace_of,
+)
+from .post_import import when_imported
 from .primitives import PRIMITIVES, math_bindings, sympy_bindings, xp_bindings
 
 #: A NumPy batch of more than this many elements whose compiled loop is not ready
@@ -62,9 +72,9 @@ SINGLE_HOT = 64
 #: floats (about 1 us each), faster there than the element-wise NumPy path.
 ROWS_MAX = 16
 
-_HELPERS: dict[str, Helper] = {}
 _F64 = np.dtype(np.float64)
 _F32 = np.dtype(np.float32)
+_F16 = np.dtype(np.float16)
 
 
 def _free_names(fn) -> set[str]:
@@ -81,34 +91,62 @@ def _rebind(fn, bindings: dict):
 
 
 class _Rebindable:
-    """Shared machinery of helpers and kernels: dependency walk and rebinding."""
+    """Shared machinery of helpers and kernels: dependency walk and rebinding.
+
+    A function's callees are resolved in its own module, at definition: every free
+    name that is not a primitive is a :class:`Helper` or :class:`Kernel` (whose
+    scalar function is then called like a helper) that the module defines or
+    imports under its own name. There is no global registry, so two modules may
+    each have a helper ``f``; but one function's callees, transitively, must
+    have distinct names (the numba binding writes them into one module), which
+    is checked here.
+    """
+
+    #: See :func:`helper`; kernels are never ``numerical``.
+    numerical = False
 
     def __init__(self, fn):
         self.fn = fn
         self.name = fn.__name__
         self.__doc__ = fn.__doc__
         self.__wrapped__ = fn
-        for name in _free_names(fn):
-            if name not in PRIMITIVES and name not in _HELPERS and not _is_builtin(name):
+        self._deps = self._resolve()
+
+    def _resolve(self) -> list[_Rebindable]:
+        """The callees of ``fn``, transitively, callees first (see the class doc)."""
+        order: list[_Rebindable] = []
+        seen: dict[str, _Rebindable] = {self.name: self}
+        for name in sorted(_free_names(self.fn)):
+            if name in PRIMITIVES:
+                continue
+            callee = self.fn.__globals__.get(name)
+            if not isinstance(callee, _Rebindable):
+                if _is_builtin(name):
+                    continue
                 raise NameError(
                     f"kernel {self.name} uses {name!r}, which is neither a primitive "
-                    f"nor a registered helper"
+                    f"nor a helper or kernel of its module {self.fn.__module__}"
                 )
-
-    def dependencies(self) -> list[Helper]:
-        """Helpers called by this function, transitively, callees first."""
-        order: list[Helper] = []
-        seen: set[str] = set()
-
-        def visit(fn):
-            for name in sorted(_free_names(fn)):
-                if name in _HELPERS and name not in seen:
-                    seen.add(name)
-                    visit(_HELPERS[name].fn)
-                    order.append(_HELPERS[name])
-
-        visit(self.fn)
+            if callee.name != name:
+                raise NameError(
+                    f"kernel {self.name} calls {callee.name!r} as {name!r}: import "
+                    f"helpers under their own name"
+                )
+            for dep in (*callee._deps, callee):
+                prev = seen.setdefault(dep.name, dep)
+                if prev is dep:
+                    if dep not in order:
+                        order.append(dep)
+                    continue
+                raise NameError(
+                    f"kernel {self.name} depends on two functions named {dep.name!r} "
+                    f"(from {prev.fn.__module__} and {dep.fn.__module__}); rename one"
+                )
         return order
+
+    def dependencies(self) -> list[_Rebindable]:
+        """Helpers (and kernels) called by this function, transitively, callees first."""
+        return list(self._deps)
 
     def bound(self, primitives: dict, *, scalar=False):
         """This function with ``primitives`` and rebound helpers as its globals.
@@ -182,11 +220,46 @@ class Helper(_Rebindable):
         return self._py(*args)
 
 
-def helper(fn) -> Helper:
-    """Register ``fn`` as a helper that kernels may call by name."""
-    h = Helper(fn)
-    _HELPERS[h.name] = h
-    return h
+def _refuse_redefinition(fn) -> None:
+    """Refuse a second helper or kernel of one name in one module.
+
+    Callees are looked up by name in the module (see :class:`_Rebindable`), so a
+    second definition would silently replace the first for every function
+    defined after it. Running the same definition again (a module reload) is
+    not a second one.
+    """
+    prev = fn.__globals__.get(fn.__name__)
+    if not isinstance(prev, _Rebindable):
+        return
+    same = (prev.fn.__module__, prev.fn.__code__.co_firstlineno) == (
+        fn.__module__,
+        fn.__code__.co_firstlineno,
+    )
+    if not same:
+        raise NameError(
+            f"{fn.__module__} already has a helper or kernel {fn.__name__!r} (from "
+            f"{prev.fn.__module__}, line {prev.fn.__code__.co_firstlineno}); a second "
+            f"one of the same name would replace it: rename one"
+        )
+
+
+def helper(fn=None, *, numerical=False):
+    """Make ``fn`` a helper that kernels of its module, or importing it, may call.
+
+    ``@helper(numerical=True)`` marks a helper whose ``where`` branches are
+    numerical devices, not cases of the mathematics: a series below a threshold
+    and the closed form above it, or a safe argument that keeps a gradient
+    finite. Its exact value is one function, which the SymPy closed form
+    (:mod:`rigidkit.symbolic`) writes as the branch taken at a generic point.
+    """
+
+    def make(fn):
+        _refuse_redefinition(fn)
+        h = Helper(fn)
+        h.numerical = numerical
+        return h
+
+    return make if fn is None else make(fn)
 
 
 class Kernel(_Rebindable):
@@ -205,6 +278,23 @@ class Kernel(_Rebindable):
         # lock by the fast path, so entries are only ever added.
         self._ready: dict = {}
         self._nsingle: dict = {}  # one-element calls counted per loop key
+        _TORCH_KERNELS.add(self)
+        if _TORCH_BOUND:
+            self._bind_torch()
+
+    def _bind_torch(self):
+        """Bind this kernel to torch now (float32 and float64), not at first use.
+
+        ``torch.compile`` cannot trace the making of a function (the rebinding), and
+        a kernel's first torch call may come inside a compiled function. Scalars
+        are lifted to CPU tensors (``device=None``), which torch combines with
+        tensors of any device, so one binding per dtype serves every device.
+        """
+        xp = _torch_namespace()
+        for dtype in (xp.float32, xp.float64):
+            key = ("torch", str(dtype), "None")
+            if key not in self._xp_cache:
+                self._xp_cache[key] = self.bound(xp_bindings(xp, dtype, None))
 
     # -- scalar bindings -------------------------------------------------
     @property
@@ -239,6 +329,11 @@ class Kernel(_Rebindable):
         subclass of one instance, so later calls go straight to it: one Python
         frame between the caller and the numba loop.
         """
+        first = args[len(self.params)] if len(args) > len(self.params) else None
+        if type(first) is not np.ndarray and not isinstance(first, _PLAIN):
+            # Not NumPy: no fast path needed yet (and torch.compile could not trace
+            # its generation).
+            return self._call(*args, out=out, backend=backend)
         fast = self._make_fast()
         self.__class__ = type(f"Kernel_{self.name}", (type(self),), {"__call__": fast})
         return fast(self, *args, out=out, backend=backend)
@@ -300,11 +395,23 @@ class Kernel(_Rebindable):
         if is_numpy(xp) and xp is not np and backend != "xp":
             xp = np
         if xp is np:
+            for a in arrays:
+                if type(a) is not np.ndarray and dask_backend.is_dask(a):
+                    return self._call_dask(params, arrays, out)
             arrays = [np.asarray(a) for a in arrays]
         batch = self._batch_shape(xp, arrays)
         if xp is np and backend != "xp":
             return self._call_numpy(params, arrays, batch, out, backend)
         return self._call_xp(xp, params, arrays, batch)
+
+    def _call_dask(self, params, arrays, out):
+        """Dask input: a lazy graph of this kernel over the chunks (see dask_backend)."""
+        if out is not None:
+            raise ValueError(f"{self.name}: out= takes NumPy arrays, not Dask arrays")
+        arrays = [a if dask_backend.is_dask(a) else np.asarray(a) for a in arrays]
+        self._batch_shape(np, arrays)  # shape errors now, not at compute time
+        dtype = float_dtype_of(np, *[np.empty(0, dtype=a.dtype) for a in arrays])
+        return dask_backend.call(self, params, arrays, dtype)
 
     def _single_out(self, res, out, dt):
         """Write one element's results ``res`` (a tuple of floats) into ``out=``."""
@@ -363,6 +470,14 @@ class Kernel(_Rebindable):
     # -- numpy ---------------------------------------------------------------
     def _call_numpy(self, params, arrays, batch, out, backend):
         dtype = float_dtype_of(np, *arrays)
+        if dtype is _F16:  # kept, computed in float32 (numba has no float16)
+            res = self._call_numpy(
+                params, [a.astype(_F32) for a in arrays], batch, None, backend
+            )
+            res = self._finish(
+                [r.astype(_F16) for r in ([res] if len(self.outputs) == 1 else res)]
+            )
+            return res if out is None else self._write_out(res, out)
         n = math.prod(batch)
         if n == 0:
             return self._finish(self._outputs(batch, dtype, out))
@@ -480,6 +595,11 @@ class Kernel(_Rebindable):
     # -- any array namespace --------------------------------------------------
     def _call_xp(self, xp, params, arrays, batch):
         dtype = float_dtype_of(xp, *arrays)
+        if is_half(dtype):  # kept, computed in float32
+            work = [xp.asarray(a, dtype=xp.float32) for a in arrays]
+            res = self._call_xp(xp, params, work, batch)
+            res = [res] if len(self.outputs) == 1 else res
+            return self._finish([xp.asarray(r, dtype=dtype) for r in res])
         device = next((device_of(a) for a in arrays if device_of(a) is not None), None)
         arrays = [xp.asarray(a, dtype=dtype, device=device) for a in arrays]
         comps = []
@@ -491,7 +611,10 @@ class Kernel(_Rebindable):
                 a, tuple(a.shape[: a.ndim - len(trail)]) + (math.prod(trail),)
             )
             comps += [flat[..., c] for c in range(math.prod(trail))]
-        key = (getattr(xp, "__name__", id(xp)), str(dtype), str(device))
+        name = getattr(xp, "__name__", id(xp))
+        if name == "torch":
+            device = None  # see _bind_torch
+        key = (name, str(dtype), str(device))
         fn = self._xp_cache.get(key)
         if fn is None:
             fn = self._xp_cache[key] = self.bound(xp_bindings(xp, dtype, device))
@@ -513,6 +636,21 @@ class Kernel(_Rebindable):
 
 
 _INTS = (int, np.integer)
+_PLAIN = (list, tuple, int, float, type(None))
+
+#: Every kernel, for binding to torch once torch is imported (see Kernel._bind_torch).
+_TORCH_KERNELS: weakref.WeakSet = weakref.WeakSet()
+_TORCH_BOUND = False
+
+
+def _bind_all_torch():
+    global _TORCH_BOUND
+    _TORCH_BOUND = True
+    for k in list(_TORCH_KERNELS):
+        k._bind_torch()
+
+
+when_imported("torch", _bind_all_torch)
 
 
 def _ints(params) -> tuple:
@@ -532,6 +670,7 @@ def kernel(inputs, outputs, params=()):
     """
 
     def wrap(fn):
+        _refuse_redefinition(fn)
         return Kernel(fn, inputs, outputs, params)
 
     return wrap

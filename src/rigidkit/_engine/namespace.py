@@ -13,6 +13,8 @@ import types
 
 import numpy as np
 
+from .post_import import when_imported
+
 _TORCH_NS = None
 
 
@@ -85,6 +87,11 @@ def _torch_namespace():
     return _TORCH_NS
 
 
+# Built when torch is imported, not at first use: ``torch.compile`` cannot trace the
+# construction of the namespace, and a first use may be inside a compiled function.
+when_imported("torch", _torch_namespace)
+
+
 def is_torch(x) -> bool:
     return type(x).__module__.startswith("torch") and hasattr(x, "requires_grad")
 
@@ -117,7 +124,20 @@ def is_numpy(xp) -> bool:
 
 
 def device_of(x):
-    return getattr(x, "device", None) if not isinstance(x, np.ndarray) else None
+    """The device to make arrays on that meet ``x``: None for NumPy and JAX.
+
+    JAX places its arrays itself (a traced array's ``device`` is not a device, and
+    ``asarray(tracer, device=...)`` fails under ``jax.jacfwd``), so new JAX arrays
+    are never pinned; torch and CuPy arrays name theirs.
+    """
+    if isinstance(x, np.ndarray) or type(x).__module__.startswith("jax"):
+        return None
+    return getattr(x, "device", None)
+
+
+def is_half(dtype) -> bool:
+    """True for float16 and bfloat16 of any namespace (kept, but computed in float32)."""
+    return dtype is _NP_F16 or str(dtype).endswith("float16")
 
 
 def float_dtype_of(xp, *arrays):
@@ -128,9 +148,7 @@ def float_dtype_of(xp, *arrays):
             if all(d is dts[0] for d in dts):  # the common case, without result_type
                 return dts[0]
         dt = np.result_type(*dts) if dts else np.dtype(np.float64)
-        if not np.issubdtype(dt, np.floating):
-            return np.dtype(np.float64)
-        if dt == np.float16 or dt.itemsize > 8:
+        if not np.issubdtype(dt, np.floating) or dt.itemsize > 8:
             return np.dtype(np.float64)
         return dt
     dts = [a.dtype for a in arrays if hasattr(a, "dtype")]
@@ -138,11 +156,14 @@ def float_dtype_of(xp, *arrays):
     f32 = xp.float32
     if dts and all(d == f32 for d in dts):
         return f32
+    if dts and all(d == dts[0] for d in dts) and is_half(dts[0]):
+        return dts[0]
     return f64
 
 
 _NP_F64 = np.dtype(np.float64)
 _NP_F32 = np.dtype(np.float32)
+_NP_F16 = np.dtype(np.float16)
 
 
 def is_float32(dtype) -> bool:

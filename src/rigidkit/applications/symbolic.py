@@ -33,21 +33,33 @@ a kernel with several outputs returns a tuple.
 
 ``closed_form=True`` (the default) gives the mathematics: each special-case
 coefficient (``sinc``, ``versinc2``, ... of :mod:`rigidkit.kernels.coefficients`,
-a Taylor series below a threshold and the closed form above it) appears as its
+and every other helper marked ``numerical``: a Taylor series below a threshold
+and the closed form above it) appears as its
 closed form, ``sin(t)/t``, taken from the coefficient's own code at a generic
 (large, positive) argument; and the float literals of the code become the exact
 rationals they spell (``0.5`` is ``1/2``). These closed forms hold away from the
 coefficients' removable singularities (``sin(t)/t`` is 0/0 at ``t = 0``): for
 numbers there, or the exact arithmetic of the numeric kernels, ``closed_form=False``
 gives exactly what the kernels evaluate, series and thresholds included, as
-``Piecewise``. The branches a kernel takes itself (the sign flip to ``w >= 0``,
-a zero norm, Shepperd's four cases) stay ``Piecewise`` in both forms; SymPy
-decides them where the symbols' assumptions allow (``positive=True``, say).
+``Piecewise``. The branches a kernel or its other helpers take (the sign flip to
+``w >= 0``, a zero norm, Shepperd's four cases) stay ``Piecewise`` in both forms;
+SymPy decides them where the symbols' assumptions allow (``positive=True``, say).
 
 Names: the kernels of SO(3) and quaternions (modules ``so3``, ``so3_jacobians``,
 ``quaternion``, ``matrix``, ``rotvec``, ``mrp``, ``axis_angle``, ``euler``,
 ``quaternion_algebra``) are top-level, and so is any name defined by a single
-kernel module; every kernel module is also a namespace (``symbolic.se3.hat``).
+kernel module; every kernel module is also a namespace (``symbolic.se3.hat``),
+and ``symbolic.so3`` holds the SO(3) calculus of ``so3_jacobians`` too. Next to
+each ``left_jacobian`` and ``left_jacobian_inverse`` (SO(3), SE(2), SE(3)) stand
+``right_jacobian`` and ``right_jacobian_inverse``, the left ones at ``-x``
+(``J_r(x) = J_l(-x)``):
+
+>>> w = sp.Matrix(sp.symbols("w0:3", real=True))
+>>> sp.simplify(symbolic.so3.right_jacobian(w) - symbolic.left_jacobian(-w))
+Matrix([
+[0, 0, 0],
+[0, 0, 0],
+[0, 0, 0]])
 """
 
 from __future__ import annotations
@@ -62,7 +74,7 @@ from fractions import Fraction
 import sympy as sp
 
 from .. import kernels as _kernels_pkg
-from .._engine.kernel import _HELPERS, Helper, Kernel, _rebind
+from .._engine.kernel import Helper, Kernel, _rebind
 from .._engine.primitives import sympy_bindings
 
 #: Kernel modules whose names are top-level, first one first for shared names.
@@ -80,6 +92,11 @@ _PREFERRED = (
 
 #: A generic point for a helper's special cases: large, positive, all different.
 _GENERIC = (101.3, 103.7, 107.9, 109.1, 113.3, 117.7, 119.9, 123.1, 127.3)
+
+
+def _generic(k: int) -> sp.Float:
+    """The generic value of the ``k``-th scalar argument (any ``k``)."""
+    return sp.Float(_GENERIC[k % len(_GENERIC)] + 30.0 * (k // len(_GENERIC)))
 
 
 def _rational(expr):
@@ -105,27 +122,32 @@ def _generic_branches(expr, point):
 
 
 def _closed_helper(helper: Helper, env: dict):
-    """``helper`` over SymPy, each of its special cases replaced by the generic branch.
+    """A numerical ``helper`` over SymPy, its special cases replaced by the generic branch.
 
-    The helper is expanded once over dummy symbols, its branches chosen at a
-    generic point, and the arguments substituted afterwards.
+    The helper is expanded once per structure of its arguments (scalars, or
+    tuples of scalars) over dummy symbols, its branches chosen at a generic
+    point, and the arguments substituted afterwards.
     """
     raw = _rebind(helper.fn, env)
-    nargs = len(inspect.signature(helper.fn).parameters)
-    dummies = tuple(sp.Dummy(f"a{k}", real=True) for k in range(nargs))
-    cache = []
+    cache: dict = {}
 
     def call(*args):
-        args = tuple(map(sp.sympify, args))
-        if not cache:
-            point = {d: sp.Float(g) for d, g in zip(dummies, _GENERIC)}
-            out = raw(*dummies)
+        shape = tuple(len(a) if isinstance(a, (tuple, list)) else None for a in args)
+        if shape not in cache:
+            dummies, dargs = [], []
+            for n in shape:
+                ds = [sp.Dummy(f"a{len(dummies) + k}", real=True) for k in range(n or 1)]
+                dummies += ds
+                dargs.append(ds[0] if n is None else tuple(ds))
+            point = {d: _generic(k) for k, d in enumerate(dummies)}
+            out = raw(*dargs)
             if isinstance(out, tuple):
-                cache.append(tuple(_generic_branches(sp.sympify(o), point) for o in out))
+                out = tuple(_generic_branches(sp.sympify(o), point) for o in out)
             else:
-                cache.append(_generic_branches(sp.sympify(out), point))
-        sub = dict(zip(dummies, args))
-        out = cache[0]
+                out = _generic_branches(sp.sympify(out), point)
+            cache[shape] = (dummies, out)
+        dummies, out = cache[shape]
+        sub = dict(zip(dummies, map(sp.sympify, _flatten(args)), strict=True))
         if isinstance(out, tuple):
             return tuple(o.xreplace(sub) for o in out)
         return out.xreplace(sub)
@@ -134,9 +156,14 @@ def _closed_helper(helper: Helper, env: dict):
 
 
 def _closed_function(kernel: Kernel):
+    """The kernel over SymPy with its numerical helpers in closed form.
+
+    Other helpers and kernels it calls are expanded as written, branches
+    included, like the kernel's own body.
+    """
     env = dict(sympy_bindings())
     for dep in kernel.dependencies():
-        env[dep.name] = _closed_helper(_HELPERS[dep.name], env)
+        env[dep.name] = _closed_helper(dep, env) if dep.numerical else _rebind(dep.fn, env)
     return _rebind(kernel.fn, env)
 
 
@@ -216,6 +243,26 @@ def _make(kernel: Kernel, module: str):
     return symbolic_form
 
 
+def _right(left, name: str):
+    """The right Jacobian (or its inverse) from the left one: ``J_r(x) = J_l(-x)``.
+
+    ``exp(x + d) ~ exp(x) exp(J_r(x) d)`` and ``exp(x + d) ~ exp(J_l(x) d) exp(x)``
+    to first order in ``d``; since ``exp(-x) = exp(x)^-1``, inverting the second
+    at ``-x`` gives the first.
+    """
+
+    def right(*args, closed_form=True):
+        return left(*[-sp.sympify(a) for a in _flatten(args)], closed_form=closed_form)
+
+    right.__name__ = right.__qualname__ = name
+    right.__module__ = __name__
+    right.__doc__ = (
+        f"SymPy form of the right-side ``{name}``: ``{left.__name__}`` at ``-x`` "
+        f"(``J_r(x) = J_l(-x)``), same calling convention.\n\n" + (left.__doc__ or "")
+    )
+    return right
+
+
 def _collect():
     by_module: dict[str, dict] = {}
     for info in pkgutil.iter_modules(_kernels_pkg.__path__):
@@ -227,6 +274,13 @@ def _collect():
         }
         if found:
             by_module[info.name] = found
+    for fns in by_module.values():
+        for left in ("left_jacobian", "left_jacobian_inverse"):
+            if left in fns:
+                right = left.replace("left", "right", 1)
+                fns.setdefault(right, _right(fns[left], right))
+    # SO(3) calculus under so3 too, as in rk.so3.
+    by_module["so3"] = {**by_module["so3_jacobians"], **by_module["so3"]}
     top: dict[str, object] = {}
     for module in _PREFERRED:
         for name, fn in by_module.get(module, {}).items():

@@ -6,12 +6,15 @@ first omitted term is below 1e-16 relative at the threshold, so float64 (and,
 a fortiori, float32) gets a correctly rounded-ish value; above it, the closed form,
 whose relative error there is a few ulp because no cancellation is left. The
 closed form is evaluated at a safe argument so the unused branch stays finite.
+
+Each is a ``numerical`` helper (see :func:`rigidkit._engine.helper`): its
+branches are one function, so :mod:`rigidkit.symbolic` writes it in closed form.
 """
 
 from .._engine import helper
 
 
-@helper
+@helper(numerical=True)
 def sinc(x):
     """``sin(x) / x``.
 
@@ -24,7 +27,7 @@ def sinc(x):
     return where(small, series, sin(safe) / safe)
 
 
-@helper
+@helper(numerical=True)
 def versinc2(x):
     """``(1 - cos(x)) / x**2``, computed as ``2 sin^2(x/2) / x^2`` (no cancellation).
 
@@ -38,7 +41,7 @@ def versinc2(x):
     return where(small, series, 2.0 * s * s)
 
 
-@helper
+@helper(numerical=True)
 def sin_defect3(x):
     """``(x - sin(x)) / x**3``.
 
@@ -92,7 +95,7 @@ def sin_defect3(x):
     return where(small, series, (safe - sin(safe)) / (safe * safe * safe))
 
 
-@helper
+@helper(numerical=True)
 def atan_ratio(n, w):
     """``atan2(n, w) / n`` for ``n >= 0`` (the angle over the sine, quaternion log).
 
@@ -112,7 +115,7 @@ def atan_ratio(n, w):
     return where(small, series, atan2(safe_n, w) / safe_n)
 
 
-@helper
+@helper(numerical=True)
 def cos_defect4(x):
     """``(cos(x) - 1 + x**2/2) / x**4`` (1/24 at 0), the third SE(3) Jacobian coefficient.
 
@@ -126,7 +129,7 @@ def cos_defect4(x):
     return sin_defect3(y) * (1.0 + sinc(y)) * 0.125
 
 
-@helper
+@helper(numerical=True)
 def cot_defect2(x):
     """``(1 - (x/2) cot(x/2)) / x**2`` (1/12 at 0), the coefficient of SO(3) ``J^-1``.
 
@@ -144,7 +147,7 @@ def cot_defect2(x):
     return (versinc2(y) - sin_defect3(y)) / (4.0 * sinc(y))
 
 
-@helper
+@helper(numerical=True)
 def sin_cos_defect5(x):
     """``(2x - 3 sin(x) + x cos(x)) / (2 x**5)`` (1/120 at 0), last coefficient of ``Q``.
 
@@ -175,7 +178,7 @@ def sin_cos_defect5(x):
     return where(small, s / 120.0, closed)
 
 
-@helper
+@helper(numerical=True)
 def exprel(x):
     """``(exp(x) - 1) / x`` (1 at 0), as ``scipy.special.exprel``.
 
@@ -192,7 +195,7 @@ def exprel(x):
     return where(small, s, (exp(safe) - 1.0) / safe)
 
 
-@helper
+@helper(numerical=True)
 def norm3(x, y, z):
     """``sqrt(x^2 + y^2 + z^2)`` whose gradient is 0, not NaN, at the origin.
 

@@ -31,7 +31,7 @@ sequence to the cyclic one: for proper sequences the parity sign is absorbed by
 """
 
 from .._engine import kernel
-from .so2 import angle_of  # noqa: F401  (bound by name)
+from .so2 import angle_of
 
 
 @kernel(

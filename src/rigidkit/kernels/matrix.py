@@ -1,6 +1,7 @@
 """Kernels between unit quaternions and 3x3 rotation matrices (row-major)."""
 
 from .._engine import helper, kernel
+from .vector import det3
 
 
 @helper
@@ -52,8 +53,9 @@ def quat_from_matrix(r00, r01, r02, r10, r11, r12, r20, r21, r22):
     First one Newton step towards the orthogonal polar factor (the nearest rotation
     in Frobenius norm): with ``C = M^T M - I``, ``N = M (I - C/2)``. The polar factor
     is ``M (I + C)^(-1/2) = M (I - C/2 + 3 C^2/8 - ...)``, so ``N`` is it up to
-    ``3/8 |C|^2``: below 1e-20 for a matrix 1e-10 off, 4e-13 at the default
-    tolerance 1e-6, and a rounding-level change for a rotation. Without this step a
+    ``3/8 |C|^2``: below 1e-20 for a matrix 1e-10 off, 1.5e-12 for one written to
+    6 decimals (``|C| <= 2e-6``), 4e-11 at the default tolerance 1e-5, and a
+    rounding-level change for a rotation. Without this step a
     perturbation ``e`` moves the result by ``e`` instead of ``e^2``.
 
     Then Shepperd's method on ``N``: of the four expressions ``4w^2, 4x^2, 4y^2,
@@ -96,13 +98,16 @@ def quat_from_matrix(r00, r01, r02, r10, r11, r12, r20, r21, r22):
     z = where(use0, n10 - n01, where(use1, n02 + n20, where(use2, n12 + n21, t3)))
     n = sqrt(w * w + x * x + y * y + z * z)
     n = where(n > 0.0, n, 1.0)
-    det = (
-        r00 * (r11 * r22 - r12 * r21)
-        - r01 * (r10 * r22 - r12 * r20)
-        + r02 * (r10 * r21 - r11 * r20)
-    )
-    err = maximum(
-        maximum(maximum(abs(c00), abs(c11)), maximum(abs(c22), abs(c01))),
-        maximum(maximum(abs(c02), abs(c12)), abs(det - 1.0)),
+    det = det3(r00, r01, r02, r10, r11, r12, r20, r21, r22)
+    # A NaN entry makes det NaN (every entry is a factor of some product in it), and
+    # 0 * det keeps that NaN in err, which ``maximum`` alone may drop (numba's and
+    # Python's maximum return the other operand): so the caller's err <= tol test
+    # fails and reports the NaN (NonFiniteError) instead of returning NaN.
+    err = (
+        maximum(
+            maximum(maximum(abs(c00), abs(c11)), maximum(abs(c22), abs(c01))),
+            maximum(maximum(abs(c02), abs(c12)), abs(det - 1.0)),
+        )
+        + 0.0 * det
     )
     return (w / n, x / n, y / n, z / n, err)

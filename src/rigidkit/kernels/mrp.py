@@ -1,6 +1,7 @@
 """Kernels between unit quaternions and modified Rodrigues parameters (MRP)."""
 
 from .._engine import kernel
+from .quaternion import quat_hemisphere
 
 
 @kernel(inputs=[(3,)], outputs=[(4,)])
@@ -14,6 +15,6 @@ def quat_from_mrp(px, py, pz):
 @kernel(inputs=[(4,)], outputs=[(3,)])
 def mrp_from_quat(w, x, y, z):
     """``p = v / (1 + w)`` with ``w >= 0`` first, so ``|p| <= 1`` (theta <= pi)."""
-    s = where(w < 0.0, -1.0, 1.0)
-    d = 1.0 + s * w
-    return (s * x / d, s * y / d, s * z / d)
+    w, x, y, z = quat_hemisphere(w, x, y, z)
+    d = 1.0 + w
+    return (x / d, y / d, z / d)

@@ -6,26 +6,9 @@ a unit quaternion are in :mod:`.quaternion`; this module adds what a non-unit
 quaternion needs: inverse, exp, log and the 4x4 product matrices.
 """
 
-from .._engine import helper, kernel
-from .coefficients import sinc  # noqa: F401  (bound by name)
-
-
-@helper
-def scaled_norm3(x, y, z):
-    """``(m, r)`` with ``|(x, y, z)| = m r``: ``m`` the largest ``|component|``.
-
-    ``r`` is in ``[1, sqrt(3)]`` unless the vector is zero (then ``m = r = 0``), so
-    no square under- or overflows for any finite input; ``(x, y, z) / (m r)`` is
-    the unit direction to an ulp.
-    """
-    m = maximum(maximum(abs(x), abs(y)), abs(z))
-    pos = m > 0.0
-    safe = where(pos, m, 1.0)
-    xs = x / safe
-    ys = y / safe
-    zs = z / safe
-    # the root at a safe argument: a finite (zero) gradient at the origin, not NaN
-    return (m, where(pos, sqrt(where(pos, xs * xs + ys * ys + zs * zs, 1.0)), 0.0))
+from .._engine import kernel
+from .coefficients import atan_ratio, norm3, sinc, versinc2
+from .vector import normalize4, scaled4
 
 
 @kernel(inputs=[(4,)], outputs=[(4,), ()])
@@ -35,14 +18,9 @@ def quat_inverse(w, x, y, z):
     With ``m = max|q_i|`` and ``q = m p``: ``q^-1 = p* / (|p|^2 m)``, ``|p|^2`` in
     [1, 4]. The zero quaternion gives zeros and ``m = 0``, which callers reject.
     """
-    m = maximum(maximum(abs(w), abs(x)), maximum(abs(y), abs(z)))
-    safe = where(m > 0.0, m, 1.0)
-    w1 = w / safe
-    x1 = x / safe
-    y1 = y / safe
-    z1 = z / safe
-    n2 = w1 * w1 + x1 * x1 + y1 * y1 + z1 * z1
-    k = 1.0 / (where(m > 0.0, n2, 1.0) * safe)
+    w1, x1, y1, z1, m, r = scaled4(w, x, y, z)
+    pos = m > 0.0
+    k = 1.0 / (where(pos, r * r, 1.0) * where(pos, m, 1.0))
     return (k * w1, -k * x1, -k * y1, -k * z1, m)
 
 
@@ -54,11 +32,16 @@ def quat_exp(w, x, y, z):
     ``|v|`` is formed without overflow. Overflows (inf) once ``w`` > ~709.78
     (float64), like ``exp`` itself.
     """
-    m, r = scaled_norm3(x, y, z)
+    _, _, _, _, m, r = scaled4(x, y, z, 0.0)
     n = m * r
     e = exp(w)
     k = e * sinc(n)
-    return (e * cos(n), k * x, k * y, k * z)
+    # Below |v| = 1, cos|v| = 1 - |v|^2 versinc2(|v|), a function of |v|^2: through
+    # the norm alone autodiff has no second derivative at v = 0 (see
+    # rotvec.quat_angle_from_rotvec); the subtracted term is below 1/2, no accuracy lost.
+    n2 = x * x + y * y + z * z
+    c = where(n2 < 1.0, 1.0 - n2 * versinc2(n), cos(n))
+    return (e * c, k * x, k * y, k * z)
 
 
 @kernel(inputs=[(4,)], outputs=[(4,), ()])
@@ -76,23 +59,27 @@ def quat_log(w, x, y, z):
     0, 0)``. The zero quaternion has no logarithm: the second output, ``max|q_i|``,
     is 0 for it, and callers reject it.
     """
-    mv, rv = scaled_norm3(x, y, z)
-    has_v = mv > 0.0
-    theta = atan2(mv * rv, w)
-    # u = (v / mv) / rv: neither factor under- or overflows.
-    d1 = where(has_v, mv, 1.0)
-    d2 = where(has_v, rv, 1.0)
-    ux = where(has_v, x / d1 / d2, 1.0)
-    uy = y / d1 / d2
-    uz = z / d1 / d2
+    ux, uy, uz, _, nv = normalize4(x, y, z, 0.0)
+    theta = atan2(nv, w)
+    ux = where(nv > 0.0, ux, 1.0)
     # log|q| = log(M) + log(|q| / M), M = max |q_i|: |q| / M is in [1, 2].
-    big = maximum(abs(w), mv)
-    safe_big = where(big > 0.0, big, 1.0)
-    ws = w / safe_big
-    ns = mv / safe_big * rv
-    rq = sqrt(ws * ws + ns * ns)
-    log_norm = log(safe_big) + log(where(big > 0.0, rq, 1.0))
-    return (log_norm, theta * ux, theta * uy, theta * uz, big)
+    ws, xs, ys, zs, big, r = scaled4(w, x, y, z)
+    pos = big > 0.0
+    log_norm = log(where(pos, big, 1.0)) + log(where(pos, r, 1.0))
+    # Near the positive real axis theta u is written (theta / |v|) v, with
+    # atan_ratio's series (the same value): theta u alone has the derivative of
+    # u = v / |v| at v = 0, namely 0, where d(theta u)/dv = I / w. On q / M
+    # (theta u is scale-invariant), so 1 / w cannot overflow.
+    ns = norm3(xs, ys, zs)
+    near_real = ns < 0.02 * ws  # atan_ratio's series region (w > 0)
+    k = atan_ratio(where(near_real, ns, 1.0), where(near_real, ws, 1.0))  # safe if unused
+    return (
+        log_norm,
+        where(near_real, k * xs, theta * ux),
+        where(near_real, k * ys, theta * uy),
+        where(near_real, k * zs, theta * uz),
+        big,
+    )
 
 
 @kernel(inputs=[(4,)], outputs=[(4, 4)])

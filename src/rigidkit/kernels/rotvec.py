@@ -1,29 +1,67 @@
-"""Kernels between unit quaternions and rotation vectors ``theta * axis``."""
+"""Kernels between unit quaternions and rotation vectors ``theta * axis``.
+
+The two helpers here are the exponential and logarithm of SO(3) on quaternions,
+written once: the SE(3) and Sim(3) kernels call them for their rotation part.
+"""
 
 from .._engine import helper, kernel
-from .coefficients import atan_ratio, norm3, sinc  # noqa: F401  (bound by name)
-from .matrix import matrix_entries_from_quat  # noqa: F401  (bound by name)
+from .coefficients import atan_ratio, norm3, sinc, versinc2
+from .matrix import matrix_entries_from_quat
+from .quaternion import quat_hemisphere
 
 
 @helper
-def quat_entries_from_rotvec(rx, ry, rz):
-    """``(cos(theta/2), sin(theta/2)/theta * r)``, ``theta = |r|``, as four scalars.
+def quat_angle_from_rotvec(rx, ry, rz):
+    """``(cos(theta/2), sin(theta/2)/theta * r)`` and ``theta = |r|``, as five scalars.
 
     ``sinc`` keeps small angles exact; a vector so small that ``|r|^2`` underflows
     gives theta = 0 and q = (1, r/2), still right to the last bit. ``norm3`` keeps
     the gradient finite (``dq/dr = I/2``) at ``r = 0``, where ``d|r|/dr`` is 0/0.
+
+    Below ``theta = 1``, ``cos(theta/2)`` is ``1 - (|r|^2 / 4) versinc2(theta/2)``,
+    a function of ``|r|^2``: through ``theta`` alone autodiff gets no second
+    derivative at ``r = 0`` (``|r|`` has none; ``norm3`` says 0), so the Hessian of
+    ``w`` there came out 0 instead of ``-I/4``. The subtracted term is below 1/8
+    there, so this costs no accuracy; above 1 the plain cosine is as accurate.
     """
     theta = norm3(rx, ry, rz)
     half = 0.5 * theta
     s = 0.5 * sinc(half)
-    return (cos(half), s * rx, s * ry, s * rz)
+    t2 = rx * rx + ry * ry + rz * rz
+    w = where(t2 < 1.0, 1.0 - 0.25 * t2 * versinc2(half), cos(half))
+    return (w, s * rx, s * ry, s * rz, theta)
+
+
+@helper
+def quat_entries_from_rotvec(rx, ry, rz):
+    """``q = (cos(theta/2), sin(theta/2)/theta * r)``: :func:`quat_angle_from_rotvec`."""
+    w, x, y, z, _ = quat_angle_from_rotvec(rx, ry, rz)
+    return (w, x, y, z)
+
+
+@helper
+def rotvec_entries_from_quat(w, x, y, z):
+    """Rotation vector ``r`` of ``q`` with angle in [0, pi], as three scalars.
+
+    ``theta = 2 atan2(|v|, |w|)`` and ``r = theta / |v| * v`` after flipping ``q`` to
+    ``w >= 0``; ``atan_ratio`` carries the small-angle series. Scale-invariant, so
+    no normalisation is needed, as long as ``|v|^2`` neither overflows nor
+    underflows (``|q|`` within 1e-150 ... 1e150 in float64, 1e-18 ... 1e18 in
+    float32); ``Rotation`` stores unit quaternions. The angle itself is
+    :func:`~rigidkit.kernels.quaternion.quat_angle`, whose flip and norm are the
+    same expressions as here (one evaluation once inlined).
+    """
+    w, x, y, z = quat_hemisphere(w, x, y, z)
+    n = norm3(x, y, z)  # a finite gradient at the identity
+    k = 2.0 * atan_ratio(n, w)
+    return (k * x, k * y, k * z)
 
 
 @kernel(inputs=[(3,)], outputs=[(4,)])
 def quat_from_rotvec(rx, ry, rz):
     """``q = (cos(theta/2), sin(theta/2)/theta * r)``, ``theta = |r|``.
 
-    See :func:`quat_entries_from_rotvec`.
+    See :func:`quat_angle_from_rotvec`.
     """
     return quat_entries_from_rotvec(rx, ry, rz)
 
@@ -32,20 +70,9 @@ def quat_from_rotvec(rx, ry, rz):
 def rotvec_from_quat(w, x, y, z):
     """Rotation vector with angle in [0, pi] of a (not necessarily unit) quaternion.
 
-    ``theta = 2 atan2(|v|, |w|)`` and ``r = theta / |v| * v`` after flipping ``q`` to
-    ``w >= 0``; ``atan_ratio`` carries the small-angle series. Scale-invariant, so
-    no normalisation is needed, as long as ``|v|^2`` neither overflows nor
-    underflows (``|q|`` within 1e-150 ... 1e150 in float64, 1e-18 ... 1e18 in
-    float32); ``Rotation`` stores unit quaternions.
+    See :func:`rotvec_entries_from_quat`.
     """
-    s = where(w < 0.0, -1.0, 1.0)
-    w = s * w
-    x = s * x
-    y = s * y
-    z = s * z
-    n = norm3(x, y, z)  # a finite gradient at the identity
-    k = 2.0 * atan_ratio(n, w)
-    return (k * x, k * y, k * z)
+    return rotvec_entries_from_quat(w, x, y, z)
 
 
 @kernel(inputs=[(3,)], outputs=[(3, 3)])

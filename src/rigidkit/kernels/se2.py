@@ -11,20 +11,58 @@ the named coefficients of :mod:`.coefficients`, so no formula here has a
 threshold of its own.
 """
 
-from .._engine import kernel
-from .coefficients import sin_defect3, sinc, versinc2  # noqa: F401  (bound by name)
-from .so2 import angle_of, complex_from_block  # noqa: F401  (bound by name)
+from .._engine import helper, kernel
+from .coefficients import sin_defect3, sinc, versinc2
+from .so2 import (
+    angle_between,
+    angle_of,
+    complex_apply,
+    complex_from_block,
+    complex_multiply,
+)
+
+
+@helper
+def se2_v_coeffs(w):
+    """``(a, b)`` of ``V(ω) = [[a, -b], [b, a]]``: ``a = sinc(ω)``, ``b = ω versinc2(ω)``.
+
+    ``a = sin ω / ω`` and ``b = (1 - cos ω)/ω``, both exact through ω = 0.
+    """
+    return (sinc(w), w * versinc2(w))
+
+
+@helper
+def se2_v_inverse_coeffs(w):
+    """``(α, h)`` of ``V(ω)^-1 = [[α, h], [-h, α]]``: ``h = ω/2``, ``α = cos h / sinc h``.
+
+    ``V = a I + b J`` and ``J^2 = -I`` give ``V^-1 = (a I - b J)/(a^2 + b^2)``;
+    with half-angle identities this is ``V^-1 = α I - (ω/2) J``,
+    ``α = (ω/2) cot(ω/2)``. For |ω| <= pi, sinc(ω/2) >= 2/pi, so the only special
+    case is sinc's own (at 0); near pi, α -> 0 with an absolute error of an ulp.
+    At ω = ±2 pi, ``V`` is singular and α overflows, as it should.
+    """
+    h = 0.5 * w
+    return (cos(h) / sinc(h), h)
+
+
+@helper
+def se2_q(vx, vy, w):
+    """``q = (e vx + d vy, e vy - d vx)``, ``d = (1 - cos ω)/ω^2``, ``e = (ω - sin ω)/ω^2``.
+
+    The derivative of ``t = V(ω) v`` along ω, the last column of the SE(2) ``J_l``.
+    """
+    d = versinc2(w)
+    e = w * sin_defect3(w)
+    return (e * vx + d * vy, e * vy - d * vx)
 
 
 @kernel(inputs=[(3,)], outputs=[(4,)])
 def pose_from_twist(vx, vy, w):
     """``exp``: ``R = (cos ω, sin ω)``, ``t = V(ω) v``, ``V = [[a, -b], [b, a]]``.
 
-    ``a = sin ω / ω = sinc(ω)`` and ``b = (1 - cos ω)/ω = ω versinc2(ω)``, both
-    exact through ω = 0 (pure translation, ``t = v``).
+    See :func:`se2_v_coeffs`; ω = 0 gives the pure translation ``t = v``.
     """
-    a = sinc(w)
-    b = w * versinc2(w)
+    a, b = se2_v_coeffs(w)
     return (cos(w), sin(w), a * vx - b * vy, b * vx + a * vy)
 
 
@@ -32,15 +70,10 @@ def pose_from_twist(vx, vy, w):
 def twist_from_pose(c, s, tx, ty):
     """``log``: ``ω = angle(c + i s)`` in (-pi, pi], ``v = V(ω)^-1 t``.
 
-    ``V = a I + b J`` and ``J^2 = -I`` give ``V^-1 = (a I - b J)/(a^2 + b^2)``;
-    with half-angle identities this is ``V^-1 = α I - (ω/2) J``,
-    ``α = (ω/2) cot(ω/2) = cos(ω/2) / sinc(ω/2)``. For |ω| <= pi, sinc(ω/2) >=
-    2/pi, so the only special case is sinc's own (at 0); near pi, α -> 0 with an
-    absolute error of an ulp. The input need not be exactly unit.
+    See :func:`se2_v_inverse_coeffs`. The input need not be exactly unit.
     """
     w = angle_of(c, s)
-    h = 0.5 * w
-    alpha = cos(h) / sinc(h)
+    alpha, h = se2_v_inverse_coeffs(w)
     return (alpha * tx + h * ty, alpha * ty - h * tx, w)
 
 
@@ -66,12 +99,9 @@ def pose_from_matrix(m00, m01, m02, m10, m11, m12, m20, m21, m22):
 @kernel(inputs=[(4,), (4,)], outputs=[(4,)])
 def pose_multiply(c1, s1, x1, y1, c2, s2, x2, y2):
     """Composition ``T1 T2`` (``T2`` first): ``(R1 R2, R1 t2 + t1)``."""
-    return (
-        c1 * c2 - s1 * s2,
-        s1 * c2 + c1 * s2,
-        c1 * x2 - s1 * y2 + x1,
-        s1 * x2 + c1 * y2 + y1,
-    )
+    c, s = complex_multiply(c1, s1, c2, s2)
+    x, y = complex_apply(c1, s1, x2, y2)
+    return (c, s, x + x1, y + y1)
 
 
 @kernel(inputs=[(4,)], outputs=[(4,)])
@@ -83,13 +113,14 @@ def pose_inverse(c, s, tx, ty):
 @kernel(inputs=[(4,), (2,)], outputs=[(2,)])
 def pose_apply(c, s, tx, ty, x, y):
     """Map the point ``p``: ``R p + t``."""
-    return (c * x - s * y + tx, s * x + c * y + ty)
+    rx, ry = complex_apply(c, s, x, y)
+    return (rx + tx, ry + ty)
 
 
 @kernel(inputs=[(4,), (4,)], outputs=[(), ()])
 def pose_distance(c1, s1, x1, y1, c2, s2, x2, y2):
     """Rotation angle between the poses (in [0, pi]) and translation distance."""
-    angle = abs(atan2(c1 * s2 - s1 * c2, c1 * c2 + s1 * s2))
+    (angle,) = angle_between(c1, s1, c2, s2)
     dx = x2 - x1
     dy = y2 - y1
     return (angle, sqrt(dx * dx + dy * dy))
@@ -138,27 +169,20 @@ def left_jacobian(vx, vy, w):
     ``e = (ω - sin ω)/ω^2``: the derivative of ``t = V(ω) v`` along ω, moved to the
     left. The right Jacobian is ``J_l(-ξ)``.
     """
-    a = sinc(w)
-    d = versinc2(w)
-    b = w * d
-    e = w * sin_defect3(w)
-    return (a, -b, e * vx + d * vy, b, a, e * vy - d * vx, 0.0, 0.0, 1.0)
+    a, b = se2_v_coeffs(w)
+    qx, qy = se2_q(vx, vy, w)
+    return (a, -b, qx, b, a, qy, 0.0, 0.0, 1.0)
 
 
 @kernel(inputs=[(3,)], outputs=[(3, 3)])
 def left_jacobian_inverse(vx, vy, w):
     """Inverse of the left Jacobian: ``[[V^-1, -V^-1 q], [0, 1]]`` (see ``left_jacobian``).
 
-    ``V^-1 = [[α, h], [-h, α]]``, ``h = ω/2``, ``α = cos h / sinc h`` (see
-    ``twist_from_pose``). Defined for |ω| < 2 pi; at ω = ±2 pi, ``V`` is singular
-    and the entries overflow to huge values, as they should.
+    ``V^-1`` from :func:`se2_v_inverse_coeffs`, ``q`` from :func:`se2_q`. Defined for
+    |ω| < 2 pi.
     """
-    h = 0.5 * w
-    alpha = cos(h) / sinc(h)
-    d = versinc2(w)
-    e = w * sin_defect3(w)
-    qx = e * vx + d * vy
-    qy = e * vy - d * vx
+    alpha, h = se2_v_inverse_coeffs(w)
+    qx, qy = se2_q(vx, vy, w)
     return (
         alpha,
         h,

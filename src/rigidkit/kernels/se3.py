@@ -12,55 +12,31 @@ SE(3) is ``[[J_l(w), Q(v, w)], [0, J_l(w)]]`` with Barfoot's ``Q``.
 """
 
 from .._engine import helper, kernel
-from . import matrix as _matrix
-from . import quaternion as _quaternion
-from .coefficients import (  # noqa: F401  (bound by name)
-    atan_ratio,
+from .coefficients import (
     cos_defect4,
+    cot_defect2,
     norm3,
     sin_cos_defect5,
     sin_defect3,
-    sinc,
     versinc2,
 )
-from .so3_jacobians import (  # noqa: F401  (bound by name)
-    cross3,
+from .matrix import matrix_from_quat
+from .quaternion import quat_angle, quat_apply, quat_compose
+from .rotvec import quat_angle_from_rotvec, rotvec_entries_from_quat
+from .so3_jacobians import (
     eye_hat_hat2_apply,
     so3_left_jacobian_entries,
     so3_left_jacobian_inverse_entries,
 )
-
-# The quaternion product, rotation and matrix formulas are written once, as the
-# kernels of quaternion.py and matrix.py; registering their scalar functions as
-# helpers lets the pose kernels below call them by name (inlined per backend).
-helper(_quaternion.quat_multiply.fn)
-helper(_quaternion.quat_apply.fn)
-helper(_matrix.matrix_from_quat.fn)
-
-
-@helper
-def mat33_mul(a0, a1, a2, a3, a4, a5, a6, a7, a8, b0, b1, b2, b3, b4, b5, b6, b7, b8):
-    """Entries of the 3x3 product ``A @ B`` (row-major in and out)."""
-    return (
-        a0 * b0 + a1 * b3 + a2 * b6,
-        a0 * b1 + a1 * b4 + a2 * b7,
-        a0 * b2 + a1 * b5 + a2 * b8,
-        a3 * b0 + a4 * b3 + a5 * b6,
-        a3 * b1 + a4 * b4 + a5 * b7,
-        a3 * b2 + a4 * b5 + a5 * b8,
-        a6 * b0 + a7 * b3 + a8 * b6,
-        a6 * b1 + a7 * b4 + a8 * b7,
-        a6 * b2 + a7 * b5 + a8 * b8,
-    )
+from .vector import cross3, hat_matmul, mat33_mul
 
 
 @helper
 def se3_adjoint_entries(r0, r1, r2, r3, r4, r5, r6, r7, r8, tx, ty, tz):
     """Entries of ``Ad = [[R, hat(t) R], [0, R]]`` (6x6, row-major), twists ``(v, w)``."""
-    # hat(t) R, column by column: t x (column j of R).
-    c00, c10, c20 = cross3(tx, ty, tz, r0, r3, r6)
-    c01, c11, c21 = cross3(tx, ty, tz, r1, r4, r7)
-    c02, c12, c22 = cross3(tx, ty, tz, r2, r5, r8)
+    c00, c01, c02, c10, c11, c12, c20, c21, c22 = hat_matmul(
+        tx, ty, tz, r0, r1, r2, r3, r4, r5, r6, r7, r8
+    )
     return (
         r0, r1, r2, c00, c01, c02,
         r3, r4, r5, c10, c11, c12,
@@ -138,8 +114,8 @@ def pose_from_quat_translation(w, x, y, z, tx, ty, tz):
 
 @kernel(inputs=[(7,), (7,)], outputs=[(7,)])
 def pose_compose(w1, x1, y1, z1, tx1, ty1, tz1, w2, x2, y2, z2, tx2, ty2, tz2):
-    """``T1 @ T2`` (``T2`` first): ``(q1 q2, t1 + R1 t2)``."""
-    w, x, y, z = quat_multiply(w1, x1, y1, z1, w2, x2, y2, z2)
+    """``T1 @ T2`` (``T2`` first): ``(q1 q2, t1 + R1 t2)``, ``q1 q2`` renormalised."""
+    w, x, y, z = quat_compose(w1, x1, y1, z1, w2, x2, y2, z2)
     rx, ry, rz = quat_apply(w1, x1, y1, z1, tx2, ty2, tz2)
     return (w, x, y, z, tx1 + rx, ty1 + ry, tz1 + rz)
 
@@ -181,13 +157,11 @@ def pose_from_twist(vx, vy, vz, wx, wy, wz):
     gives the pure translation ``v``. This equals the errata form of DESIGN.md,
     ``(I - R)(w x v)/t^2 + w w^T v / t^2``.
     """
-    theta = norm3(wx, wy, wz)
-    half = 0.5 * theta
-    s = 0.5 * sinc(half)
+    qw, qx, qy, qz, theta = quat_angle_from_rotvec(wx, wy, wz)
     tx, ty, tz = eye_hat_hat2_apply(
         wx, wy, wz, versinc2(theta), sin_defect3(theta), vx, vy, vz
     )
-    return (cos(half), s * wx, s * wy, s * wz, tx, ty, tz)
+    return (qw, qx, qy, qz, tx, ty, tz)
 
 
 @kernel(inputs=[(7,)], outputs=[(6,)])
@@ -198,17 +172,8 @@ def twist_from_pose(w, x, y, z, tx, ty, tz):
     ``atan2``, no cancellation near 0 or pi) and ``v = J_l(w)^-1 t``, where
     ``J_l^-1 = I - hat(w)/2 + cot_defect2(t) hat(w)^2`` is finite up to ``t = pi``.
     """
-    s = where(w < 0.0, -1.0, 1.0)
-    w = s * w
-    x = s * x
-    y = s * y
-    z = s * z
-    n = norm3(x, y, z)
-    k = 2.0 * atan_ratio(n, w)
-    theta = 2.0 * atan2(n, w)
-    rx = k * x
-    ry = k * y
-    rz = k * z
+    rx, ry, rz = rotvec_entries_from_quat(w, x, y, z)
+    theta = quat_angle(w, x, y, z)
     vx, vy, vz = eye_hat_hat2_apply(rx, ry, rz, -0.5, cot_defect2(theta), tx, ty, tz)
     return (vx, vy, vz, rx, ry, rz)
 

@@ -24,19 +24,14 @@ with ``alpha = 1 / a``, and ``1 / f(z)`` in the plane, which gives (see
 """
 
 from .._engine import helper, kernel
-from . import matrix as _matrix
-from . import quaternion as _quaternion
-from .coefficients import atan_ratio, exprel, norm3, sinc, versinc2  # noqa: F401
-
-# The quaternion product, rotation and matrix formulas are written once, as the
-# kernels of quaternion.py and matrix.py; registered as helpers (as kernels/se3.py
-# does too; registering again is harmless) the kernels below call them by name.
-helper(_quaternion.quat_multiply.fn)
-helper(_quaternion.quat_apply.fn)
-helper(_matrix.matrix_from_quat.fn)
+from .coefficients import exprel, sinc, versinc2
+from .matrix import matrix_from_quat
+from .quaternion import quat_angle, quat_apply, quat_compose
+from .rotvec import quat_angle_from_rotvec, rotvec_entries_from_quat
+from .vector import cross3, hat_matmul, hat_poly_apply
 
 
-@helper
+@helper(numerical=True)
 def sim3_v_coeffs(sigma, theta):
     """``(a, b, c)`` of ``V = a I + b hat(w) + c hat(w)^2`` (module docs), theta >= 0.
 
@@ -89,15 +84,6 @@ def sim3_v_coeffs(sigma, theta):
     return (a, where(small, sb, b), where(small, 0.5 * sc, c))
 
 
-@helper
-def sim3_cross_terms(wx, wy, wz, vx, vy, vz):
-    """``(w x v, w x (w x v))`` as a 6-tuple."""
-    cx = wy * vz - wz * vy
-    cy = wz * vx - wx * vz
-    cz = wx * vy - wy * vx
-    return (cx, cy, cz, wy * cz - wz * cy, wz * cx - wx * cz, wx * cy - wy * cx)
-
-
 @kernel(inputs=[(7,)], outputs=[(8,)])
 def sim3_exp(vx, vy, vz, wx, wy, wz, sigma):
     """Similarity ``expm(hat(xi))`` of a twist ``(v, omega, sigma)``: ``(q, V v, e^sigma)``.
@@ -105,21 +91,10 @@ def sim3_exp(vx, vy, vz, wx, wy, wz, sigma):
     The rotation is ``q = (cos(theta/2), sinc(theta/2) omega / 2)`` (exact for small
     angles); ``V`` as in the module docs, applied as ``a v + b w x v + c w x (w x v)``.
     """
-    theta = norm3(wx, wy, wz)
+    qw, qx, qy, qz, theta = quat_angle_from_rotvec(wx, wy, wz)
     a, b, c = sim3_v_coeffs(sigma, theta)
-    cx, cy, cz, dx, dy, dz = sim3_cross_terms(wx, wy, wz, vx, vy, vz)
-    half = 0.5 * theta
-    k = 0.5 * sinc(half)
-    return (
-        cos(half),
-        k * wx,
-        k * wy,
-        k * wz,
-        a * vx + b * cx + c * dx,
-        a * vy + b * cy + c * dy,
-        a * vz + b * cz + c * dz,
-        exp(sigma),
-    )
+    tx, ty, tz = hat_poly_apply(wx, wy, wz, a, b, c, vx, vy, vz)
+    return (qw, qx, qy, qz, tx, ty, tz, exp(sigma))
 
 
 @kernel(inputs=[(8,)], outputs=[(7,)])
@@ -134,17 +109,8 @@ def sim3_log(w, x, y, z, tx, ty, tz, s):
     (a |f|^2)`` (no 1/theta left). All of ``b, c, Re f`` are divided by ``a`` first
     so ``|f|^2`` does not overflow for scales up to e^700.
     """
-    sg = where(w < 0.0, -1.0, 1.0)
-    w = sg * w
-    x = sg * x
-    y = sg * y
-    z = sg * z
-    n = norm3(x, y, z)
-    k = 2.0 * atan_ratio(n, w)
-    wx = k * x
-    wy = k * y
-    wz = k * z
-    theta = 2.0 * atan2(n, w)
+    wx, wy, wz = rotvec_entries_from_quat(w, x, y, z)
+    theta = quat_angle(w, x, y, z)
     sigma = log(where(s > 0.0, s, 1.0))
     a, b, c = sim3_v_coeffs(sigma, theta)
     b1 = b / a
@@ -155,22 +121,17 @@ def sim3_log(w, x, y, z, tx, ty, tz, s):
     alpha = 1.0 / a
     beta = -b1 / (a * f2)
     gamma = (b1 * b1 - c1 * re1) / (a * f2)
-    cx, cy, cz, dx, dy, dz = sim3_cross_terms(wx, wy, wz, tx, ty, tz)
-    return (
-        alpha * tx + beta * cx + gamma * dx,
-        alpha * ty + beta * cy + gamma * dy,
-        alpha * tz + beta * cz + gamma * dz,
-        wx,
-        wy,
-        wz,
-        sigma,
-    )
+    vx, vy, vz = hat_poly_apply(wx, wy, wz, alpha, beta, gamma, tx, ty, tz)
+    return (vx, vy, vz, wx, wy, wz, sigma)
 
 
 @kernel(inputs=[(8,), (8,)], outputs=[(8,)])
 def sim3_compose(w1, x1, y1, z1, tx1, ty1, tz1, s1, w2, x2, y2, z2, tx2, ty2, tz2, s2):
-    """``S1 S2``: ``(q1 q2, s1 R1 t2 + t1, s1 s2)`` (``S2`` applied first)."""
-    w, x, y, z = quat_multiply(w1, x1, y1, z1, w2, x2, y2, z2)
+    """``S1 S2``: ``(q1 q2, s1 R1 t2 + t1, s1 s2)`` (``S2`` applied first).
+
+    ``q1 q2`` is renormalised (:func:`~rigidkit.kernels.quaternion.quat_compose`).
+    """
+    w, x, y, z = quat_compose(w1, x1, y1, z1, w2, x2, y2, z2)
     rx, ry, rz = quat_apply(w1, x1, y1, z1, tx2, ty2, tz2)
     return (w, x, y, z, s1 * rx + tx1, s1 * ry + ty1, s1 * rz + tz1, s1 * s2)
 
@@ -210,16 +171,9 @@ def sim3_adjoint(w, x, y, z, tx, ty, tz, s):
     ``X hat(xi) X^-1 = [[hat(R w) + sigma I, s R v - (hat(R w) + sigma I) t], [0, 0]]``.
     """
     r00, r01, r02, r10, r11, r12, r20, r21, r22 = matrix_from_quat(w, x, y, z)
-    # hat(t) R, column by column: t x (column j of R)
-    m00 = ty * r20 - tz * r10
-    m10 = tz * r00 - tx * r20
-    m20 = tx * r10 - ty * r00
-    m01 = ty * r21 - tz * r11
-    m11 = tz * r01 - tx * r21
-    m21 = tx * r11 - ty * r01
-    m02 = ty * r22 - tz * r12
-    m12 = tz * r02 - tx * r22
-    m22 = tx * r12 - ty * r02
+    m00, m01, m02, m10, m11, m12, m20, m21, m22 = hat_matmul(
+        tx, ty, tz, r00, r01, r02, r10, r11, r12, r20, r21, r22
+    )
     return (
         s * r00, s * r01, s * r02, m00, m01, m02, -tx,
         s * r10, s * r11, s * r12, m10, m11, m12, -ty,
@@ -271,13 +225,16 @@ def sim3_bracket(vx, vy, vz, wx, wy, wz, s, ux, uy, uz, px, py, pz, r):
     For ``xi1 = (v, w, s)``, ``xi2 = (u, p, r)``: the ``sigma I`` parts commute, so
     the bracket has no scale component.
     """
+    ax, ay, az = cross3(wx, wy, wz, ux, uy, uz)
+    bx, by, bz = cross3(px, py, pz, vx, vy, vz)
+    cx, cy, cz = cross3(wx, wy, wz, px, py, pz)
     return (
-        wy * uz - wz * uy + s * ux - (py * vz - pz * vy) - r * vx,
-        wz * ux - wx * uz + s * uy - (pz * vx - px * vz) - r * vy,
-        wx * uy - wy * ux + s * uz - (px * vy - py * vx) - r * vz,
-        wy * pz - wz * py,
-        wz * px - wx * pz,
-        wx * py - wy * px,
+        ax + s * ux - bx - r * vx,
+        ay + s * uy - by - r * vy,
+        az + s * uz - bz - r * vz,
+        cx,
+        cy,
+        cz,
         0.0,
     )
 

@@ -6,6 +6,7 @@ complex multiplication; its matrix is ``[[c, -s], [s, c]] = exp(θ J)`` with
 """
 
 from .._engine import helper, kernel
+from .vector import normalize4, renormalize4
 
 
 @helper
@@ -18,6 +19,18 @@ def angle_of(c, s):
     """
     a = atan2(s, c)
     return where(a <= -pi, -a, a)
+
+
+@kernel(inputs=[(2,)], outputs=[(2,), ()])
+def complex_normalize(c, s):
+    """``z / |z|`` and ``|z|``, scaled by the largest component (no overflow).
+
+    See :func:`~rigidkit.kernels.vector.normalize4`.
+
+    A zero input gives zero components and norm 0, which callers reject.
+    """
+    c, s, _, _, n = normalize4(c, s, 0.0, 0.0)
+    return (c, s, n)
 
 
 @helper
@@ -33,35 +46,13 @@ def complex_from_block(m00, m01, m10, m11):
     The defect is ``max(max|M^T M - I|, |det M - 1|)``: 0 for a rotation, 2 for
     a reflection; callers compare it to their tolerance.
     """
-    a = m00 + m11
-    b = m10 - m01
-    m = maximum(abs(a), abs(b))
-    safe_m = where(m > 0.0, m, 1.0)
-    a = a / safe_m
-    b = b / safe_m
-    n = sqrt(a * a + b * b)
-    safe_n = where(m > 0.0, n, 1.0)
+    c, s, n = complex_normalize(m00 + m11, m10 - m01)
     e00 = m00 * m00 + m10 * m10 - 1.0
     e11 = m01 * m01 + m11 * m11 - 1.0
     e01 = m00 * m01 + m10 * m11
     det = m00 * m11 - m01 * m10
     err = maximum(maximum(abs(e00), abs(e11)), maximum(abs(e01), abs(det - 1.0)))
-    return (a / safe_n, b / safe_n, n * m, err)
-
-
-@kernel(inputs=[(2,)], outputs=[(2,), ()])
-def complex_normalize(c, s):
-    """``z / |z|`` and ``|z|``, scaled by the largest component (no overflow).
-
-    A zero input gives zero components and norm 0, which callers reject.
-    """
-    m = maximum(abs(c), abs(s))
-    safe = where(m > 0.0, m, 1.0)
-    c1 = c / safe
-    s1 = s / safe
-    n = sqrt(c1 * c1 + s1 * s1)
-    safe_n = where(m > 0.0, n, 1.0)
-    return (c1 / safe_n, s1 / safe_n, n * m)
+    return (c, s, n, err)
 
 
 @kernel(inputs=[(1,)], outputs=[(2,)])
@@ -86,8 +77,13 @@ def angle_from_complex(c, s):
 
 @kernel(inputs=[(2,), (2,)], outputs=[(2,)])
 def complex_multiply(c1, s1, c2, s2):
-    """Product ``z1 z2``: the rotation by ``θ1 + θ2`` (commutative in 2D)."""
-    return (c1 * c2 - s1 * s2, s1 * c2 + c1 * s2)
+    """Product ``z1 z2``: the rotation by ``θ1 + θ2`` (commutative in 2D).
+
+    Renormalised (:func:`~rigidkit.kernels.vector.renormalize4`), so chains of
+    compositions stay unit to a few ulp.
+    """
+    c, s, _, _ = renormalize4(c1 * c2 - s1 * s2, s1 * c2 + c1 * s2, 0.0, 0.0)
+    return (c, s)
 
 
 @kernel(inputs=[(2,)], outputs=[(2,)])

@@ -13,13 +13,8 @@ here are shared with the SE(3) kernels (exp of a twist is ``J_l(w) v``).
 """
 
 from .._engine import helper, kernel
-from .coefficients import cot_defect2, norm3, sin_defect3, versinc2  # noqa: F401  (bound by name)
-
-
-@helper
-def cross3(ax, ay, az, bx, by, bz):
-    """Cross product ``a x b`` (= ``hat(a) @ b``)."""
-    return (ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx)
+from .coefficients import cot_defect2, norm3, sin_defect3, versinc2
+from .vector import cross3, hat_poly_apply
 
 
 @helper
@@ -50,9 +45,7 @@ def eye_hat_hat2(wx, wy, wz, a, b):
 @helper
 def eye_hat_hat2_apply(wx, wy, wz, a, b, vx, vy, vz):
     """``(I + a hat(w) + b hat(w)^2) v = v + a w x v + b w x (w x v)``."""
-    cx, cy, cz = cross3(wx, wy, wz, vx, vy, vz)
-    dx, dy, dz = cross3(wx, wy, wz, cx, cy, cz)
-    return (vx + a * cx + b * dx, vy + a * cy + b * dy, vz + a * cz + b * dz)
+    return hat_poly_apply(wx, wy, wz, 1.0, a, b, vx, vy, vz)
 
 
 @helper

@@ -20,6 +20,7 @@ import numpy as np
 
 from .._engine.namespace import namespace_of
 from ..errors import ShapeError
+from . import _pytree
 
 __all__ = ["BatchedArray", "batch_shape"]
 
@@ -29,14 +30,33 @@ def batch_shape(shape) -> tuple:
     return (shape,) if isinstance(shape, int) else tuple(shape)
 
 
+def _wrap_both(storage: str):
+    """``_wrap`` of a class that stores its array under its own name too.
+
+    Two slots hold the one array, ``_data`` (read by the shared code) and the
+    class's own name (``_quat``, read by its methods), each written directly: no
+    property on the hot path, and ``torch.compile`` (whose tracer tells slot
+    aliases apart) reads what was written under either name.
+    """
+    namespace: dict = {}
+    exec(
+        f"def _wrap(cls, data):\n"
+        f"    obj = cls.__new__(cls)\n"
+        f"    obj._data = obj.{storage} = data\n"
+        f"    return obj\n",
+        namespace,
+    )
+    return namespace["_wrap"]
+
+
 class BatchedArray:
     """Mixin: a batch of elements stored in one array of shape ``batch + _trail``.
 
     A subclass sets ``_trail`` (the trailing shape of one element) and declares the
     slot that holds the array; when that slot is not called ``_data`` it names it in
-    ``_storage`` (``Rotation`` keeps its quaternions in ``_quat``). ``_data`` is then
-    the very same slot under a second name (the slot's descriptor is aliased, no
-    property and no copy), so ``_wrap`` and the methods below read and write it at
+    ``_storage`` (``Rotation`` keeps its quaternions in ``_quat``) and declares a
+    ``_data`` slot too, and every constructor writes the array into both (the
+    generated ``_wrap`` does), so the methods below and the class's own read it at
     plain attribute speed. A single element has batch shape ``()``.
 
     Subclasses implement :meth:`_repr_single`, the ``repr`` of one element.
@@ -59,10 +79,11 @@ class BatchedArray:
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
-        if cls._storage != "_data" and cls._storage in cls.__dict__:
-            cls._data = cls.__dict__[cls._storage]
+        if cls._storage != "_data" and "_wrap" not in cls.__dict__:
+            cls._wrap = classmethod(_wrap_both(cls._storage))
         cls._cut = -len(cls._trail)  # shape[:_cut] is the batch shape
         cls._whole = (slice(None),) * len(cls._trail)  # index of one whole element
+        _pytree.register(cls)  # a JAX pytree and torch pytree node, lazily
 
     @classmethod
     def _wrap(cls, data):

@@ -1,0 +1,463 @@
+"""Gradients of every differentiable public op, in torch and JAX, against finite differences.
+
+The table ``OPS`` lists each op as a function of one flat parameter vector per batch
+element (a rotation vector, a quaternion, a twist, Euler angles, ...). Every op is
+evaluated on one batch whose rows are the points that break formulas: random points,
+a rotation (or vector part) of exactly 0, of 1e-8, of ``pi - 1e-5`` and of exactly
+``pi`` (plus, for the Euler ops, a third angle of exactly 0 and a gimbal lock; for
+the quaternion algebra, real quaternions). For each backend (torch autograd, JAX)
+and dtype (float64, float32):
+
+* first derivatives (the Jacobian, one reverse pass per output) against central
+  differences of the float64 NumPy evaluation, ``h = 1e-6`` (1e-7 within 1e-5 of a
+  singularity): truncation ``h^2 |f'''| / 6`` plus rounding ``eps |f| / h``, below
+  1e-9 of the scale of the Jacobian; the tolerance is 1e-6 of it (float64) or 2e-3
+  (float32, whose own rounding is ~1e-7 / h of the derivative);
+* second derivatives of ``c . f`` (``c`` random; forward-over-reverse in JAX,
+  double backward in torch) against second differences of values, ``h = 1e-4``:
+  truncation ``h^2 |f''''| / 12`` plus rounding ``4 eps |f| / h^2``, ~1e-8; the
+  tolerance is 1e-5 of the scale (float64) or 5e-2 (float32).
+
+Where an op is not differentiable (the angle and axis at the identity, the logarithm
+at exactly pi, Euler angles at gimbal lock) only finiteness is asserted: no NaN, no
+infinity. Where a singularity lies closer than the second-difference step (1e-5 from
+pi), the second derivatives are checked for finiteness only. NaN is always a failure.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation as SciRotation
+
+import rigidkit as rk
+
+KINDS = ("random", "random", "zero", "tiny", "near_pi", "pi")
+H1 = {"near_pi": 1e-7}  # first-difference step by kind (default 1e-6)
+H2 = 1e-4
+
+
+# -- points -----------------------------------------------------------------------------
+
+
+def rotvecs(rng, kinds=KINDS):
+    """One rotation vector per kind: random angle in (0.3, 2.8), 0, 1e-8, pi - 1e-5, pi."""
+    axes = rng.standard_normal((len(kinds), 3))
+    axes /= np.linalg.norm(axes, axis=-1, keepdims=True)
+    angle = {"zero": 0.0, "tiny": 1e-8, "near_pi": math.pi - 1e-5, "pi": math.pi}
+    t = np.array([angle.get(k, rng.uniform(0.3, 2.8)) for k in kinds])
+    return axes * t[:, None]
+
+
+def quats(rng, kinds=KINDS):
+    """Unit quaternions (w, x, y, z) of :func:`rotvecs`, from scipy, ``w >= 0``."""
+    q = SciRotation.from_rotvec(rotvecs(rng, kinds)).as_quat(scalar_first=True)
+    return q * np.where(q[:, :1] < 0, -1.0, 1.0)
+
+
+def with_random(x, rng, n):
+    """Append ``n`` standard normal parameters (vectors, translations) to each row."""
+    return np.concatenate([x, rng.standard_normal((x.shape[0], n))], axis=-1)
+
+
+def twists(rng, kinds=KINDS):
+    return np.concatenate([rng.standard_normal((len(kinds), 3)), rotvecs(rng, kinds)], -1)
+
+
+def euler_points(seq):
+    """Points for ``as_euler(seq)``: the standard kinds, a third angle of exactly 0
+    away from the lock, and an exact gimbal lock (not differentiable)."""
+
+    def build(rng):
+        q = quats(rng)
+        proper = seq[0].lower() == seq[2].lower()
+        mid = 1.0 if proper else 0.4
+        lock = 0.0 if proper else math.pi / 2
+        extra = [[0.3, mid, 0.0], [-2.0, mid + 0.3, 0.0], [0.7, lock, 0.0]]
+        q3 = SciRotation.from_euler(seq, extra).as_quat(scalar_first=True)
+        return np.concatenate([q, q3]), (*KINDS, "third0", "third0", "lock")
+
+    return build
+
+
+def real_quaternions(rng):
+    """General quaternions: random, positive reals (the reported case), tiny vector
+    parts, near and on the negative real axis (the branch cut of log)."""
+    q = rng.standard_normal((6, 4))
+    q[2] = [2.0, 0.0, 0.0, 0.0]
+    q[3] = [0.5, 1e-8, -2e-8, 1e-8]
+    q[4] = [-1.5, 1e-3, 0.0, 0.0]  # (finite differences need |v| >> their step)
+    q[5] = [-1.5, 0.0, 0.0, 0.0]
+    return q, ("random", "random", "zero", "tiny", "near_pi", "pi")
+
+
+def pure_quaternions(rng):
+    """Vector parts of norm random, 0, 1e-8, pi - 1e-5, pi, with a random scalar."""
+    return np.concatenate([rng.standard_normal((6, 1)), rotvecs(rng)], -1), KINDS
+
+
+# -- the table ---------------------------------------------------------------------------
+
+
+@dataclass
+class Op:
+    name: str
+    fn: object  # fn(x) -> array (P, ...), x of shape (P, n) in any namespace
+    points: object  # points(rng) -> x0 (P, n) or (x0, kinds)
+    nondiff: set = field(default_factory=set)  # kinds: finite only
+    first_only: set = field(default_factory=set)  # kinds: second derivative finite only
+
+    def __repr__(self):
+        return self.name
+
+
+def from_rotvec_points(rng):
+    return rotvecs(rng)
+
+
+def quat_points(rng):
+    return quats(rng)
+
+
+R = rk.Rotation
+T = rk.Transform
+NEAR = {"near_pi"}
+PI = {"pi"}
+CONE = {"zero", "tiny", "pi"}  # 1e-8 from the apex of a cone: finite differences cross it
+
+OPS = [
+    # SO(3): construction and conversions
+    Op("Rotation.from_rotvec", lambda x: R.from_rotvec(x).as_quat(), from_rotvec_points),
+    Op("Rotation.exp.as_matrix", lambda x: R.exp(x).as_matrix(), from_rotvec_points),
+    Op("so3.exp", lambda x: rk.so3.exp(x), from_rotvec_points),
+    Op("Rotation.from_quat", lambda x: R.from_quat(x).as_quat(), quat_points),
+    Op("Rotation.as_matrix", lambda x: R.from_quat(x).as_matrix(), quat_points),
+    Op("Rotation.as_rotvec", lambda x: R.from_quat(x).as_rotvec(), quat_points, PI, NEAR),
+    Op("Rotation.log", lambda x: R.from_quat(x).log(), quat_points, PI, NEAR),
+    # (log of the matrix of a rotation vector: matrix entries moved by the step 1e-4 of
+    # the second differences would leave SO(3) beyond from_matrix's tolerance)
+    Op("so3.log", lambda x: rk.so3.log(rk.so3.exp(x)), from_rotvec_points, PI, NEAR),
+    Op("Rotation.as_mrp", lambda x: R.from_quat(x).as_mrp(), quat_points, PI, NEAR),
+    Op("Rotation.from_mrp", lambda x: R.from_mrp(x).as_quat(), lambda rng: (
+        SciRotation.from_rotvec(rotvecs(rng)).as_mrp())),
+    Op(
+        "Rotation.from_axis_angle",
+        lambda x: R.from_axis_angle(x[..., :3], x[..., 3]).as_quat(),
+        lambda rng: np.concatenate(
+            [rng.standard_normal((6, 3)), np.linalg.norm(rotvecs(rng), axis=-1)[:, None]],
+            -1,
+        ),
+    ),
+    # The angle is |w|-like at pi and |v|-like at 0 (a cone): not differentiable there.
+    Op("Rotation.angle", lambda x: R.from_quat(x).angle, quat_points, CONE, NEAR),
+    Op("Rotation.magnitude", lambda x: R.from_quat(x).magnitude(), quat_points, CONE, NEAR),
+    Op("Rotation.axis", lambda x: R.from_quat(x).axis, quat_points, CONE, NEAR),
+    Op(
+        "Rotation.apply",
+        lambda x: R.from_quat(x[..., :4]).apply(x[..., 4:]),
+        lambda rng: with_random(quats(rng), rng, 3),
+    ),
+    Op(
+        "Rotation @ Rotation",
+        lambda x: (R.from_quat(x[..., :4]) @ R.from_quat(x[..., 4:])).as_quat(),
+        lambda rng: np.concatenate([quats(rng), quats(rng)], -1),
+    ),
+    Op("Rotation.inv", lambda x: R.from_quat(x).inv().as_quat(), quat_points),
+    Op(
+        "Rotation ** t",
+        lambda x: (R.from_quat(x[..., :4]) ** x[..., 4]).as_quat(),
+        lambda rng: with_random(quats(rng), rng, 1),
+        PI,
+        NEAR,
+    ),
+    Op(
+        "Rotation.from_euler(ZYX)",
+        lambda x: R.from_euler("ZYX", x).as_quat(),
+        lambda rng: np.concatenate([rotvecs(rng), [[0.3, 0.2, 0.0]]]),
+    ),
+    Op(
+        "Rotation.from_euler(zxz)",
+        lambda x: R.from_euler("zxz", x).as_quat(),
+        lambda rng: rotvecs(rng),
+    ),
+    # Euler angles: the third angle merely 0 is differentiable, the lock is not.
+    *[
+        Op(
+            f"Rotation.as_euler({seq})",
+            lambda x, seq=seq: R.from_quat(x).as_euler(seq),
+            euler_points(seq),
+            {"lock", "zero", "tiny"} if seq[0].lower() == seq[2].lower() else {"lock"},
+        )
+        for seq in ("ZYX", "xyz", "ZXZ", "yxy")
+    ],
+    # SO(3) Jacobians
+    *[
+        Op(f"so3.{name}", lambda x, name=name: getattr(rk.so3, name)(x), from_rotvec_points)
+        for name in (
+            "left_jacobian",
+            "right_jacobian",
+            "left_jacobian_inverse",
+            "right_jacobian_inverse",
+        )
+    ],
+    # SE(3)
+    Op("Transform.exp", lambda x: T.exp(x).as_matrix(), twists),
+    Op("se3.left_jacobian", lambda x: rk.se3.left_jacobian(x), twists),
+    Op(
+        "Transform.log",
+        lambda x: T.exp(x).log(),  # log of a pose built from its twist
+        twists,
+        PI,
+        NEAR,
+    ),
+    Op(
+        "Transform.apply",
+        lambda x: T(R.from_quat(x[..., :4]), x[..., 4:7]).apply(x[..., 7:]),
+        lambda rng: with_random(quats(rng), rng, 6),
+    ),
+    Op(
+        "Transform @ Transform",
+        lambda x: (T(R.from_quat(x[..., :4]), x[..., 4:7]) @ T.exp(x[..., 7:])).as_matrix(),
+        lambda rng: np.concatenate([with_random(quats(rng), rng, 3), twists(rng)], -1),
+    ),
+    Op(
+        "Transform.inv",
+        lambda x: T(R.from_quat(x[..., :4]), x[..., 4:]).inv().as_matrix(),
+        lambda rng: with_random(quats(rng), rng, 3),
+    ),
+    # Sim(3)
+    Op(
+        "Similarity.exp",
+        lambda x: rk.Similarity.exp(x).as_matrix(),
+        lambda rng: with_random(twists(rng), rng, 1) * np.array([1, 1, 1, 1, 1, 1, 0.3]),
+    ),
+    # the plane
+    Op(
+        "Rotation2D.exp",
+        lambda x: rk.Rotation2D.exp(x).as_matrix(),
+        lambda rng: np.linalg.norm(rotvecs(rng), axis=-1)[:, None],
+    ),
+    Op(
+        "Transform2D.exp",
+        lambda x: rk.Transform2D.exp(x).as_matrix(),
+        lambda rng: np.concatenate(
+            [rng.standard_normal((6, 2)), np.linalg.norm(rotvecs(rng), axis=-1)[:, None]], -1
+        ),
+    ),
+    Op(
+        "Transform2D.log",
+        lambda x: rk.Transform2D.exp(x).log(),
+        lambda rng: np.concatenate(
+            [rng.standard_normal((6, 2)), np.linalg.norm(rotvecs(rng), axis=-1)[:, None]], -1
+        ),
+        PI,
+        NEAR,
+    ),
+    # the quaternion algebra
+    Op("Quaternion.log", lambda x: rk.Quaternion(x).log()._q, real_quaternions, PI, NEAR),
+    Op("Quaternion.exp", lambda x: rk.Quaternion(x).exp()._q, pure_quaternions),
+    Op("Quaternion.inv", lambda x: rk.Quaternion(x).inv()._q, real_quaternions),
+    Op("Quaternion.norm", lambda x: rk.Quaternion(x).norm(), real_quaternions),
+    Op(
+        "Quaternion * Quaternion",
+        lambda x: (rk.Quaternion(x[..., :4]) * rk.Quaternion(x[..., 4:]))._q,
+        lambda rng: rng.standard_normal((4, 8)),
+    ),
+]
+
+
+def points_of(op, rng):
+    pts = op.points(rng)
+    if isinstance(pts, tuple):
+        return pts
+    x0 = np.asarray(pts, dtype=np.float64)
+    kinds = KINDS if len(x0) == len(KINDS) else ("random",) * len(x0)
+    if op.name == "Rotation.from_euler(ZYX)":
+        kinds = (*KINDS, "third0")
+    return x0, kinds
+
+
+# -- references: differences of the float64 NumPy path ---------------------------------------
+
+
+def evaluate(op, x):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", rk.GimbalLockWarning)
+        return op.fn(x)
+
+
+def flat(y, P):
+    return np.asarray(y, dtype=np.float64).reshape(P, -1)
+
+
+def fd_jacobian(op, x0, kinds):
+    P, n = x0.shape
+    h = np.array([H1.get(k, 1e-6) for k in kinds])[:, None]
+    cols = []
+    for i in range(n):
+        e = np.zeros_like(x0)
+        e[:, i] = 1.0
+        up = flat(evaluate(op, x0 + h * e), P)
+        down = flat(evaluate(op, x0 - h * e), P)
+        cols.append((up - down) / (2 * h))
+    return np.stack(cols, axis=-1)  # (P, m, n)
+
+
+def fd_hessian(op, x0, c):
+    P, n = x0.shape
+
+    def g(x):
+        return flat(evaluate(op, x), P) @ c
+
+    H = np.zeros((P, n, n))
+    g0 = g(x0)
+    E = np.eye(n)
+    for i in range(n):
+        H[:, i, i] = (g(x0 + H2 * E[i]) - 2 * g0 + g(x0 - H2 * E[i])) / H2**2
+        for j in range(i):
+            d = (
+                g(x0 + H2 * (E[i] + E[j]))
+                - g(x0 + H2 * (E[i] - E[j]))
+                - g(x0 - H2 * (E[i] - E[j]))
+                + g(x0 - H2 * (E[i] + E[j]))
+            ) / (4 * H2**2)
+            H[:, i, j] = H[:, j, i] = d
+    return H
+
+
+# -- autodiff -------------------------------------------------------------------------------
+
+
+def torch_derivatives(torch, op, x0, c, dtype):
+    x = torch.tensor(x0, dtype=dtype, requires_grad=True)
+    P, n = x0.shape
+    y = evaluate(op, x).reshape(P, -1)
+    rows = []
+    for k in range(y.shape[1]):
+        (gk,) = torch.autograd.grad(y[:, k].sum(), x, retain_graph=True, allow_unused=True)
+        rows.append(torch.zeros_like(x) if gk is None else gk)
+    J = torch.stack(rows, dim=1).detach().double().numpy()
+    x = torch.tensor(x0, dtype=dtype, requires_grad=True)
+    g = (evaluate(op, x).reshape(P, -1) * torch.tensor(c, dtype=dtype)).sum()
+    (G,) = torch.autograd.grad(g, x, create_graph=True)
+    rows = []
+    for i in range(n):
+        if G.requires_grad:
+            (hi,) = torch.autograd.grad(G[:, i].sum(), x, retain_graph=True, allow_unused=True)
+        else:
+            hi = None
+        rows.append(torch.zeros_like(x) if hi is None else hi)
+    H = torch.stack(rows, dim=1).detach().double().numpy()
+    return J, H
+
+
+def jax_derivatives(jax, op, x0, c, dtype):
+    jnp = jax.numpy
+    P, n = x0.shape
+    x = jnp.asarray(x0, dtype=dtype)
+
+    def f(x):
+        return jnp.reshape(evaluate(op, x), (P, -1))
+
+    y, vjp = jax.vjp(f, x)
+    m = y.shape[1]
+    J = np.stack(
+        [np.asarray(vjp(jnp.zeros((P, m), dtype).at[:, k].set(1))[0]) for k in range(m)],
+        axis=1,
+    )
+    cj = jnp.asarray(c, dtype=dtype)
+    grad = jax.grad(lambda x: jnp.sum(f(x) * cj))
+    H = np.stack(
+        [
+            np.asarray(jax.jvp(grad, (x,), (jnp.zeros((P, n), dtype).at[:, i].set(1),))[1])
+            for i in range(n)
+        ],
+        axis=1,
+    )
+    return J.astype(np.float64), H.astype(np.float64)
+
+
+# -- the test ---------------------------------------------------------------------------------
+
+TOL = {  # (first, second) derivatives, relative to the scale of each
+    "float64": (1e-6, 1e-5),
+    "float32": (2e-3, 5e-2),
+}
+
+
+def check(op, kinds, J, H, J_ref, H_ref, dtype_name):
+    tol1, tol2 = TOL[dtype_name]
+    for p, kind in enumerate(kinds):
+        where = f"{op.name} at {kind} (row {p})"
+        assert np.all(np.isfinite(J[p])), f"{where}: non-finite Jacobian {J[p]}"
+        assert np.all(np.isfinite(H[p])), f"{where}: non-finite Hessian {H[p]}"
+        if kind in op.nondiff:
+            continue
+        scale = max(1.0, np.abs(J_ref[p]).max())
+        err = np.abs(J[p] - J_ref[p]).max()
+        assert err <= tol1 * scale, f"{where}: Jacobian off by {err:.3g} (scale {scale:.3g})"
+        if kind in op.first_only:
+            continue
+        scale = max(1.0, np.abs(H_ref[p]).max())
+        err = np.abs(H[p] - H_ref[p]).max()
+        assert err <= tol2 * scale, f"{where}: Hessian off by {err:.3g} (scale {scale:.3g})"
+
+
+@pytest.fixture(scope="module")
+def references():
+    """Points, weights ``c`` and finite-difference derivatives of every op (float64)."""
+    out = {}
+    for k, op in enumerate(OPS):
+        rng = np.random.default_rng(1000 + k)
+        x0, kinds = points_of(op, rng)
+        m = flat(evaluate(op, x0), len(x0)).shape[1]
+        c = rng.standard_normal(m)
+        out[op.name] = (x0, kinds, c, fd_jacobian(op, x0, kinds), fd_hessian(op, x0, c))
+    return out
+
+
+@pytest.mark.parametrize("dtype_name", ["float64", "float32"])
+@pytest.mark.parametrize("op", OPS, ids=repr)
+def test_torch_gradients(op, dtype_name, torch, references):
+    x0, kinds, c, J_ref, H_ref = references[op.name]
+    J, H = torch_derivatives(torch, op, x0, c, getattr(torch, dtype_name))
+    check(op, kinds, J, H, J_ref, H_ref, dtype_name)
+
+
+@pytest.mark.parametrize("dtype_name", ["float64", "float32"])
+@pytest.mark.parametrize("op", OPS, ids=repr)
+def test_jax_gradients(op, dtype_name, jax, references):
+    x0, kinds, c, J_ref, H_ref = references[op.name]
+    J, H = jax_derivatives(jax, op, x0, c, getattr(jax.numpy, dtype_name))
+    check(op, kinds, J, H, J_ref, H_ref, dtype_name)
+
+
+def test_references_see_the_reported_errors(references):
+    """The finite differences themselves find what the issue reports (so the checks
+    above could fail): the Euler Jacobian at a third angle of 0 is the identity map
+    of the angles, and d(vector part of log)/dv = I / w at a positive real q."""
+    x0, kinds, _, J_ref, _ = references["Rotation.as_euler(ZYX)"]
+    p = kinds.index("third0")
+    q = x0[p]
+    # d(angles)/dq times dq/d(angles) (from scipy's quaternion of the angles) = I.
+    a = SciRotation.from_quat(q, scalar_first=True).as_euler("ZYX")
+    h = 1e-6
+    dq = np.stack(
+        [
+            (
+                SciRotation.from_euler("ZYX", a + h * e).as_quat(scalar_first=True)
+                - SciRotation.from_euler("ZYX", a - h * e).as_quat(scalar_first=True)
+            )
+            / (2 * h)
+            for e in np.eye(3)
+        ],
+        axis=-1,
+    )
+    np.testing.assert_allclose(J_ref[p] @ dq, np.eye(3), atol=1e-6)
+    x0, kinds, _, J_ref, _ = references["Quaternion.log"]
+    p = kinds.index("zero")
+    np.testing.assert_allclose(J_ref[p][1:, 1:], np.eye(3) / x0[p, 0], atol=1e-8)
