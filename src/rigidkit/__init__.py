@@ -6,6 +6,7 @@ Euler UPPER = intrinsic, lower = extrinsic; twists ``(v, omega)``; radians unles
 ``degrees=True``.
 """
 
+from ._validate import set_validation
 from .errors import (
     ConvergenceWarning,
     DegenerateInputError,
@@ -142,6 +143,8 @@ __all__ = [
     "sim3",
     "symbolic",
     "kinematics",
+    # the validation switch (docs/architecture.md, "Validation policy")
+    "set_validation",
     # errors and warnings
     "RigidkitError",
     "NotARotationError",

@@ -50,8 +50,8 @@ class set_validation:
     >>> import numpy as np
     >>> import rigidkit as rk
     >>> with rk.set_validation(False):
-    ...     q = rk.conversions.quat_normalize(np.array([0.0, 0.0, 0.0, 0.0]))
-    >>> bool(np.isnan(q).all())
+    ...     q = rk.conversions.quat_normalize(np.array([np.nan, 0.0, 0.0, 1.0]))
+    >>> bool(np.isnan(q).any())
     True
     """
 
@@ -194,7 +194,7 @@ def raise_where(bad, error, message, *, value=None) -> None:
     global batch index); where values cannot be read it is skipped.
     """
     if _deferred(bad):
-        dask_backend.defer(_raise_where_numpy, (bad, value), (error, message))
+        dask_backend.defer(_raise_where_numpy, (bad, value), (error, message), _relabel)
         return
     if not any_true(bad):
         return
@@ -206,6 +206,12 @@ def raise_where(bad, error, message, *, value=None) -> None:
         found = np.asarray(to_numpy(value))[idx]
         found = found.tolist() if found.ndim else float(found)
     raise error(message.format(where=where_text(idx), value=found), index=idx)
+
+
+def _relabel(err, index):
+    """``err`` (raised on a chunk) naming the batch ``index`` in the whole array."""
+    text = str(err).replace(where_text(err.index), where_text(index), 1)
+    return type(err)(text, index=index)
 
 
 def _raise_where_numpy(bad, value, error, message):
@@ -269,7 +275,9 @@ def check_finite(x, trail: tuple, what: str) -> None:
         bad = np.asarray(True)
     elif not checks_now(x):
         if _deferred(x):
-            dask_backend.defer(_check_finite_numpy, (x,), (trail, what), (len(trail),))
+            dask_backend.defer(
+                _check_finite_numpy, (x,), (trail, what), _relabel, (len(trail),)
+            )
         return
     else:
         xp = namespace_of(x)
@@ -405,7 +413,7 @@ def check_rotation(block, err, atol, *, what="matrix") -> None:
     """
     tol = default_atol(block.dtype) if atol is None else atol
     if _deferred(err):  # per chunk at compute time: the message reads the block
-        dask_backend.defer(_check_rotation_numpy, (err, block), (tol, what))
+        dask_backend.defer(_check_rotation_numpy, (err, block), (tol, what), _relabel)
         return
     ok = err <= tol
     if all_true(ok):

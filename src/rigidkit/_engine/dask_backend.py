@@ -177,7 +177,7 @@ def _register(outputs, trails, deps):
         _attach(group, item[0])
 
 
-def _check_block(check, args, ninputs, nbatch, *blocks):
+def _check_block(check, args, relabel, ninputs, nbatch, *blocks):
     """One chunk of a deferred check; an error gets the global batch index."""
     from ..errors import RigidkitError
 
@@ -185,19 +185,18 @@ def _check_block(check, args, ninputs, nbatch, *blocks):
     try:
         check(*arrays, *args)
     except RigidkitError as err:
-        local = err.index
-        if not local:
+        if not err.index:
             raise
-        glob = tuple(int(off[i]) for off, i in zip(offsets, local))
-        from .._validate import where_text
-
-        text = str(err).replace(where_text(local), where_text(glob), 1)
-        raise type(err)(text, index=glob) from None
+        glob = tuple(int(off[i]) for off, i in zip(offsets, err.index))
+        raise relabel(err, glob) from None
     return np.zeros((1,) * nbatch, dtype=bool)
 
 
-def defer(check, arrays, args, trails=None):
+def defer(check, arrays, args, relabel, trails=None):
     """Run ``check(*numpy_chunks, *args)`` per chunk of ``arrays`` at compute time.
+
+    An error it raises is replaced by ``relabel(err, global_index)`` (the same
+    error naming the index in the whole array; ``_validate`` words messages).
 
     ``arrays[0]`` is a Dask array whose batch shape the check indexes (a mask,
     or the checked array with ``trails[0]`` trailing axes); each other array (or
@@ -243,7 +242,8 @@ def defer(check, arrays, args, trails=None):
             else:
                 after = [prev.all(), ""]
         return da.blockwise(
-            _check_block, batch, check, None, tuple(args), None, len(arrays), None,
+            _check_block, batch, check, None, tuple(args), None, relabel, None,
+            len(arrays), None,
             nb, None, *pairs, *offsets, *after, adjust_chunks=dict.fromkeys(batch, 1),
             dtype=bool, concatenate=True, meta=np.empty((0,) * nb, dtype=bool),
             align_arrays=False,

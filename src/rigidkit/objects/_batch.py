@@ -16,9 +16,12 @@ its own attribute, so a single-element call pays nothing for the bases.
 
 from __future__ import annotations
 
+import functools
+import inspect
+
 import numpy as np
 
-from .._engine.namespace import namespace_of
+from .._engine.namespace import _torch_namespace, device_of, namespace_of
 from ..errors import ShapeError
 from . import _pytree
 
@@ -28,6 +31,62 @@ __all__ = ["BatchedArray", "batch_shape"]
 def batch_shape(shape) -> tuple:
     """A batch shape argument (an int or a sequence of ints) as a tuple."""
     return (shape,) if isinstance(shape, int) else tuple(shape)
+
+
+def place(data, *, like=None, xp=None, dtype=None, device=None):
+    """A NumPy array ``data`` in the namespace, dtype and device asked for.
+
+    ``like``: an array whose namespace, floating dtype and device are taken (each
+    unless given); ``xp``: a namespace (``torch``, ``jax.numpy``, ``numpy``,
+    ``array_api_strict``, ...); ``dtype``: a dtype of that namespace or its name
+    (``"float32"``); ``device``: a device of that namespace.
+    """
+    if like is not None:
+        if xp is None:
+            xp = namespace_of(like)
+        if dtype is None and "float" in str(getattr(like, "dtype", "")):
+            dtype = like.dtype
+        if device is None:
+            device = device_of(like)
+    if xp is None:
+        xp = np
+    if getattr(xp, "__name__", "") == "torch":
+        xp = _torch_namespace()
+    if isinstance(dtype, str):
+        dtype = getattr(xp, dtype)
+    if xp is np:
+        return data if dtype is None else data.astype(dtype)
+    return xp.asarray(data, dtype=dtype or xp.float64, device=device)
+
+
+def _placing(make):
+    """``identity`` / ``random`` taking ``like=``, ``xp=``, ``dtype=``, ``device=``."""
+
+    @functools.wraps(make)
+    def made(cls, *args, like=None, xp=None, dtype=None, device=None, **kwargs):
+        if like is None and xp is None and device is None:
+            return make(cls, *args, dtype=dtype, **kwargs)
+        obj = make(cls, *args, **kwargs)  # NumPy float64, then placed
+        return cls._wrap(place(obj._data, like=like, xp=xp, dtype=dtype, device=device))
+
+    made.__doc__ = (made.__doc__ or "") + _PLACING_DOC
+    sig = inspect.signature(make)
+    extra = [
+        inspect.Parameter(n, inspect.Parameter.KEYWORD_ONLY, default=None)
+        for n in ("like", "xp", "dtype", "device")
+        if n not in sig.parameters
+    ]
+    made.__signature__ = sig.replace(parameters=[*sig.parameters.values(), *extra])
+    made._placed = True
+    return classmethod(made)
+
+
+_PLACING_DOC = """
+        The result is made in any array namespace: ``like=`` an array (its
+        namespace, floating dtype and device), or ``xp=`` a namespace (``torch``,
+        ``jax.numpy``, ...), ``dtype=`` (a dtype or its name) and ``device=``; by
+        default NumPy float64.
+"""
 
 
 def _wrap_both(storage: str):
@@ -84,6 +143,10 @@ class BatchedArray:
         cls._cut = -len(cls._trail)  # shape[:_cut] is the batch shape
         cls._whole = (slice(None),) * len(cls._trail)  # index of one whole element
         _pytree.register(cls)  # a JAX pytree and torch pytree node, lazily
+        for name in ("identity", "random"):
+            made = getattr(cls, name, None)
+            if made is not None and not getattr(made, "_placed", False):
+                setattr(cls, name, _placing(made.__func__))
 
     @classmethod
     def _wrap(cls, data):
