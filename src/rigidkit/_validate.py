@@ -27,7 +27,7 @@ import math
 import numpy as np
 
 from ._engine import dask_backend
-from ._engine.namespace import is_float32, is_numpy, is_torch, namespace_of
+from ._engine.namespace import is_float32, is_half, is_numpy, is_torch, namespace_of
 from .errors import NonFiniteError, NotARotationError, ShapeError, SingularMatrixError
 
 # -- when values can be checked: concreteness and the validation switch ---------------
@@ -323,12 +323,21 @@ def default_atol(dtype) -> float:
     nearest rotation (see :func:`rigidkit.conversions.quat_from_matrix`). Tight
     enough to refuse a scaling by 1 + 1e-5 (``det - 1 = 3e-5``), and every shear,
     reflection or scaling that is not rounding noise. With 5 decimals (up to
-    1.9e-5) pass ``atol=`` or ``orthonormalize=True``.
+    1.9e-5) pass ``atol=`` or ``orthonormalize=True``. Half precision rounds each
+    entry by up to 2^-12 (float16) or 2^-9 (bfloat16), ``|R^T R - I|`` by up to
+    about three times that: 4e-3 and 3e-2.
 
-    >>> default_atol(np.float64), default_atol(np.float32)
-    (1e-05, 0.0001)
+    >>> default_atol(np.float64), default_atol(np.float32), default_atol(np.float16)
+    (1e-05, 0.0001, 0.004)
     """
+    if dtype is _F64:  # the common case, without str(dtype) (~1 us)
+        return 1e-5
+    if is_half(dtype):
+        return 3e-2 if "bfloat16" in str(dtype) else 4e-3
     return 1e-4 if is_float32(dtype) else 1e-5
+
+
+_F64 = np.dtype(np.float64)
 
 
 def singular_rtol(dtype) -> float:

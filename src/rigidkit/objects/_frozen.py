@@ -17,6 +17,8 @@ Per namespace, the cheapest array that cannot change the object:
   read-only at another, so every size gets the view. Writing into it raises
   ``ValueError: assignment destination is read-only``; ``.copy()`` it to edit.
 * JAX: the array itself (JAX arrays are immutable).
+* Dask: a new array object on the same graph (``x[i] = v`` changes only that
+  object), which computes nothing.
 * torch (no read-only tensors) and any other namespace: a copy (``clone``, which
   keeps the autograd graph).
 
@@ -49,8 +51,11 @@ def frozen(a):
         return v
     if is_torch(a):
         return a.clone()
-    if type(a).__module__.startswith("jax"):
+    module = type(a).__module__
+    if module.startswith("jax"):
         return a
+    if module.startswith("dask"):  # a new array object (x[i] = v rebinds only it): lazy
+        return a.copy()
     return namespace_of(a).asarray(a, copy=True)
 
 
