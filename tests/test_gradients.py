@@ -1,4 +1,4 @@
-"""Gradients of every differentiable public op, in torch and JAX, against finite differences.
+"""Gradients of every differentiable public op (torch, JAX) against finite differences.
 
 The table ``OPS`` lists each op as a function of one flat parameter vector per batch
 element (a rotation vector, a quaternion, a twist, Euler angles, ...). Every op is
@@ -8,7 +8,7 @@ a rotation (or vector part) of exactly 0, of 1e-8, of ``pi - 1e-5`` and of exact
 the quaternion algebra, real quaternions). For each backend (torch autograd, JAX)
 and dtype (float64, float32):
 
-* first derivatives (the Jacobian, one reverse pass per output) against central
+* first derivatives (the Jacobian, one pass per output or per input) against central
   differences of the float64 NumPy evaluation, ``h = 1e-6`` (1e-7 within 1e-5 of a
   singularity): truncation ``h^2 |f'''| / 6`` plus rounding ``eps |f| / h``, below
   1e-9 of the scale of the Jacobian; the tolerance is 1e-6 of it (float64) or 2e-3
@@ -95,6 +95,12 @@ def real_quaternions(rng):
     return q, ("random", "random", "zero", "tiny", "near_pi", "pi")
 
 
+def planar_twists(rng):
+    """``(vx, vy, omega)`` with ``|omega|`` of each kind."""
+    omega = np.linalg.norm(rotvecs(rng), axis=-1)[:, None]
+    return np.concatenate([rng.standard_normal((len(KINDS), 2)), omega], -1)
+
+
 def pure_quaternions(rng):
     """Vector parts of norm random, 0, 1e-8, pi - 1e-5, pi, with a random scalar."""
     return np.concatenate([rng.standard_normal((6, 1)), rotvecs(rng)], -1), KINDS
@@ -142,8 +148,11 @@ OPS = [
     # the second differences would leave SO(3) beyond from_matrix's tolerance)
     Op("so3.log", lambda x: rk.so3.log(rk.so3.exp(x)), from_rotvec_points, PI, NEAR),
     Op("Rotation.as_mrp", lambda x: R.from_quat(x).as_mrp(), quat_points, PI, NEAR),
-    Op("Rotation.from_mrp", lambda x: R.from_mrp(x).as_quat(), lambda rng: (
-        SciRotation.from_rotvec(rotvecs(rng)).as_mrp())),
+    Op(
+        "Rotation.from_mrp",
+        lambda x: R.from_mrp(x).as_quat(),
+        lambda rng: SciRotation.from_rotvec(rotvecs(rng)).as_mrp(),
+    ),
     Op(
         "Rotation.from_axis_angle",
         lambda x: R.from_axis_angle(x[..., :3], x[..., 3]).as_quat(),
@@ -244,16 +253,12 @@ OPS = [
     Op(
         "Transform2D.exp",
         lambda x: rk.Transform2D.exp(x).as_matrix(),
-        lambda rng: np.concatenate(
-            [rng.standard_normal((6, 2)), np.linalg.norm(rotvecs(rng), axis=-1)[:, None]], -1
-        ),
+        planar_twists,
     ),
     Op(
         "Transform2D.log",
         lambda x: rk.Transform2D.exp(x).log(),
-        lambda rng: np.concatenate(
-            [rng.standard_normal((6, 2)), np.linalg.norm(rotvecs(rng), axis=-1)[:, None]], -1
-        ),
+        planar_twists,
         PI,
         NEAR,
     ),
@@ -270,18 +275,24 @@ OPS = [
 ]
 
 
+ROWS = 9  # every op on batches of one size: JAX compiles each primitive once per shape
+
+
 def points_of(op, rng):
     pts = op.points(rng)
     if isinstance(pts, tuple):
-        return pts
-    x0 = np.asarray(pts, dtype=np.float64)
-    kinds = KINDS if len(x0) == len(KINDS) else ("random",) * len(x0)
-    if op.name == "Rotation.from_euler(ZYX)":
-        kinds = (*KINDS, "third0")
-    return x0, kinds
+        x0, kinds = pts
+    else:
+        x0 = np.asarray(pts, dtype=np.float64)
+        kinds = KINDS if len(x0) == len(KINDS) else ("random",) * len(x0)
+        if op.name == "Rotation.from_euler(ZYX)":
+            kinds = (*KINDS, "third0")
+    pad = ROWS - len(x0)  # more random points: repeats of the first, random, rows
+    x0 = np.concatenate([x0, np.resize(x0[:1], (pad, x0.shape[1]))])
+    return x0, (*kinds, *(("random",) * pad))
 
 
-# -- references: differences of the float64 NumPy path ---------------------------------------
+# -- references: differences of the float64 NumPy path ------------------------------------
 
 
 def evaluate(op, x):
@@ -329,7 +340,7 @@ def fd_hessian(op, x0, c):
     return H
 
 
-# -- autodiff -------------------------------------------------------------------------------
+# -- autodiff ----------------------------------------------------------------------------
 
 
 def torch_derivatives(torch, op, x0, c, dtype):
@@ -346,16 +357,19 @@ def torch_derivatives(torch, op, x0, c, dtype):
     (G,) = torch.autograd.grad(g, x, create_graph=True)
     rows = []
     for i in range(n):
+        hi = None
         if G.requires_grad:
-            (hi,) = torch.autograd.grad(G[:, i].sum(), x, retain_graph=True, allow_unused=True)
-        else:
-            hi = None
+            (hi,) = torch.autograd.grad(
+                G[:, i].sum(), x, retain_graph=True, allow_unused=True
+            )
         rows.append(torch.zeros_like(x) if hi is None else hi)
     H = torch.stack(rows, dim=1).detach().double().numpy()
     return J, H
 
 
 def jax_derivatives(jax, op, x0, c, dtype):
+    """The Jacobian from min(m, n) passes; the Hessian from one forward-over-reverse
+    product per input. (Eager: each pass runs rigidkit once on the whole batch.)"""
     jnp = jax.numpy
     P, n = x0.shape
     x = jnp.asarray(x0, dtype=dtype)
@@ -363,25 +377,22 @@ def jax_derivatives(jax, op, x0, c, dtype):
     def f(x):
         return jnp.reshape(evaluate(op, x), (P, -1))
 
+    def tiled(e):
+        return jnp.asarray(np.tile(e, (P, 1)), dtype=dtype)
+
     y, vjp = jax.vjp(f, x)
     m = y.shape[1]
-    J = np.stack(
-        [np.asarray(vjp(jnp.zeros((P, m), dtype).at[:, k].set(1))[0]) for k in range(m)],
-        axis=1,
-    )
+    if m <= n:  # a pullback per output row
+        J = np.stack([np.asarray(vjp(tiled(e))[0]) for e in np.eye(m)], axis=1)
+    else:  # a pushforward per input column (Jacobian matrices: 6 inputs, 36 outputs)
+        J = np.stack([np.asarray(jax.jvp(f, (x,), (tiled(e),))[1]) for e in np.eye(n)], -1)
     cj = jnp.asarray(c, dtype=dtype)
     grad = jax.grad(lambda x: jnp.sum(f(x) * cj))
-    H = np.stack(
-        [
-            np.asarray(jax.jvp(grad, (x,), (jnp.zeros((P, n), dtype).at[:, i].set(1),))[1])
-            for i in range(n)
-        ],
-        axis=1,
-    )
+    H = np.stack([np.asarray(jax.jvp(grad, (x,), (tiled(e),))[1]) for e in np.eye(n)], 1)
     return J.astype(np.float64), H.astype(np.float64)
 
 
-# -- the test ---------------------------------------------------------------------------------
+# -- the test ----------------------------------------------------------------------------
 
 TOL = {  # (first, second) derivatives, relative to the scale of each
     "float64": (1e-6, 1e-5),
@@ -399,12 +410,12 @@ def check(op, kinds, J, H, J_ref, H_ref, dtype_name):
             continue
         scale = max(1.0, np.abs(J_ref[p]).max())
         err = np.abs(J[p] - J_ref[p]).max()
-        assert err <= tol1 * scale, f"{where}: Jacobian off by {err:.3g} (scale {scale:.3g})"
+        assert err <= tol1 * scale, f"{where}: Jacobian off by {err:.3g}, scale {scale:.3g}"
         if kind in op.first_only:
             continue
         scale = max(1.0, np.abs(H_ref[p]).max())
         err = np.abs(H[p] - H_ref[p]).max()
-        assert err <= tol2 * scale, f"{where}: Hessian off by {err:.3g} (scale {scale:.3g})"
+        assert err <= tol2 * scale, f"{where}: Hessian off by {err:.3g}, scale {scale:.3g}"
 
 
 @pytest.fixture(scope="module")
