@@ -298,7 +298,7 @@ def test_jax_jacrev_and_hessian(data, jax, jnp):
     np.testing.assert_allclose(_np(J), _fd_jacobian(so3.exp, [w]), atol=1e-6)
 
     def angle(w):
-        return R_.from_rotvec(w).compose(R_.from_rotvec(w)).angle
+        return R_.from_rotvec(w).angle
 
     H = jax.jit(jax.hessian(angle))(jnp.asarray(w))
     grad = jax.jit(jax.grad(angle))
@@ -550,3 +550,21 @@ def test_no_gimbal_warning_under_tracing(jax, jnp):
         angles = jax.jit(lambda q: R_.from_quat(q).as_euler("ZYX"))(jnp.asarray(q))
     rebuilt = R_.from_euler("ZYX", np.asarray(angles))
     assert float(rebuilt.approx_equal(R_.from_quat(q), atol=1e-7)) == 1.0
+
+
+@pytest.mark.needs("jax")
+def test_pytrees_registered_lazily_after_import():
+    """``import rigidkit`` imports neither jax nor torch; the classes become pytrees
+    when jax is imported afterwards (torch uses the same hook; imported before
+    rigidkit, registration is immediate, as in this test process)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, rigidkit as rk; rk.Rotation2D;"
+        "assert 'jax' not in sys.modules and 'torch' not in sys.modules;"
+        "import jax;"
+        "assert len(jax.tree_util.tree_leaves(rk.Rotation2D.identity())) == 1;"
+        "assert len(jax.tree_util.tree_leaves(rk.Transform.identity())) == 1"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=120)
