@@ -137,7 +137,7 @@ def device_of(x):
 
 def is_half(dtype) -> bool:
     """True for float16 and bfloat16 of any namespace (kept, but computed in float32)."""
-    return dtype is _NP_F16 or str(dtype).endswith("float16")
+    return dtype is _NP_F16 or "float16" in str(dtype)
 
 
 def float_dtype_of(xp, *arrays):
