@@ -17,6 +17,8 @@ from ..functional import conversions as _conv
 from ..functional import interpolation as _interp
 from ..functional import screw as _screw
 from ..functional import se3 as _se3
+from ..kernels import dual_quaternion as _kdq
+from ..kernels import pose_formats as _kpf
 from ..kernels import se3 as _k
 from ._batch import BatchedArray, batch_shape
 from ._frozen import frozen
@@ -113,6 +115,64 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
         return cls._wrap(_se3.pose_from_twist(xi))
 
     @classmethod
+    def from_exp_coords(cls, exp_coords):
+        """From scipy's exponential coordinates ``(w, v)``, shape (..., 6).
+
+        scipy's ``RigidTransform.from_exp_coords`` puts the rotation first; our
+        :meth:`exp` takes the twist ``(v, w)``: ``from_exp_coords(c)`` is
+        ``exp(concat(c[3:], c[:3]))``. See :func:`rigidkit.se3.pose_from_exp_coords`.
+
+        >>> T = Transform.from_exp_coords([0.0, 0.0, np.pi / 2, 1.0, 0.0, 0.0])
+        >>> np.round(T.log(), 12) + 0.0  # (v, w)
+        array([1.        , 0.        , 0.        , 0.        , 0.        ,
+               1.57079633])
+
+        See Also
+        --------
+        as_exp_coords, exp
+        """
+        return cls._wrap(_se3.pose_from_exp_coords(exp_coords))
+
+    @classmethod
+    def from_dual_quat(cls, dual_quat, *, scalar_first=True):
+        """From unit dual quaternions ``(q_r, q_d)``, ``q_d = (0, t) q_r / 2``, (..., 8).
+
+        ``scalar_first=True`` (ours): ``(rw, rx, ry, rz, dw, dx, dy, dz)``;
+        ``False``: both parts scalar last, as scipy's ``RigidTransform`` (whose
+        default that is). Non-unit input is normalised as scipy does (``q_r /
+        |q_r|``; the component of ``q_d`` along ``q_r`` dropped); a zero ``q_r``
+        raises :class:`~rigidkit.ZeroNormError`. See
+        :func:`rigidkit.se3.pose_from_dual_quat`.
+
+        >>> T = Transform.from_dual_quat([1.0, 0.0, 0.0, 0.0, 0.0, 0.5, 1.0, 1.5])
+        >>> T.translation
+        array([1., 2., 3.])
+
+        See Also
+        --------
+        as_dual_quat
+        """
+        return cls._wrap(_se3.pose_from_dual_quat(dual_quat, scalar_first=scalar_first))
+
+    @classmethod
+    def from_pq(cls, pq, *, scalar_first=True):
+        """From pose vectors: translation then quaternion, shape (..., 7).
+
+        ``scalar_first=True``: ``(x, y, z, qw, qx, qy, qz)`` (pytransform3d's
+        ``pq``); ``False``: ``(x, y, z, qx, qy, qz, qw)`` (TUM trajectories, ROS
+        ``Pose``). The quaternion is normalised. See :func:`rigidkit.se3.pose_from_pq`.
+
+        >>> T = Transform.from_pq([1.0, 2.0, 3.0, 0.0, 0.0, 0.0, 1.0], scalar_first=False)
+        >>> T.translation, T.rotation.as_quat()
+        (array([1., 2., 3.]), array([1., 0., 0., 0.]))
+
+        See Also
+        --------
+        as_pq
+        """
+        return cls._wrap(_se3.pose_from_pq(pq, scalar_first=scalar_first))
+
+    @classmethod
     def random(cls, shape=(), rng=None, *, dtype=None, scale=1.0):
         """Random transforms: uniform (Haar) rotations, Gaussian translations.
 
@@ -137,6 +197,42 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
         ``w`` is the rotation vector and ``v = J_l(w)^-1 t``.
         """
         return _k.twist_from_pose(self._pose)
+
+    def as_exp_coords(self):
+        """scipy's exponential coordinates ``(w, v)``, ``|w|`` in [0, pi], (..., 6).
+
+        :meth:`log` in scipy's order (rotation first): ``as_exp_coords()`` is
+        ``concat(log()[3:], log()[:3])``. See :meth:`from_exp_coords`.
+
+        >>> np.round(Transform(translation=[1.0, 2.0, 3.0]).as_exp_coords(), 12) + 0.0
+        array([0., 0., 0., 1., 2., 3.])
+        """
+        return _kpf.exp_coords_from_pose(self._pose)
+
+    def as_dual_quat(self, *, scalar_first=True):
+        """Unit dual quaternions ``(q, (0, t) q / 2)``, shape (..., 8).
+
+        The layout of :meth:`from_dual_quat` (``scalar_first=False``: scipy's
+        default); ``q`` is the stored quaternion (``q`` and ``-q``, all 8 numbers
+        negated, are the same motion).
+
+        >>> Transform(translation=[2.0, 0.0, 0.0]).as_dual_quat()
+        array([1., 0., 0., 0., 0., 1., 0., 0.])
+        """
+        kern = _kdq.dual_quat_from_pose if scalar_first else _kdq.dual_quat_xyzw_from_pose
+        return kern(self._pose)
+
+    def as_pq(self, *, scalar_first=True):
+        """Pose vectors ``(x, y, z, qw, qx, qy, qz)``, shape (..., 7).
+
+        ``scalar_first=False`` gives TUM/ROS ``(x, y, z, qx, qy, qz, qw)``; see
+        :meth:`from_pq`.
+
+        >>> Transform(translation=[1.0, 2.0, 3.0]).as_pq(scalar_first=False)
+        array([1., 2., 3., 0., 0., 0., 1.])
+        """
+        kern = _kpf.pq_from_pose if scalar_first else _kpf.pq_xyzw_from_pose
+        return kern(self._pose)
 
     def adjoint(self):
         """Adjoint ``[[R, hat(t) R], [0, R]]``, shape (..., 6, 6), for twists ``(v, w)``.
@@ -163,14 +259,21 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
     def _include(cls, x):
         return cls(rotation=x)
 
-    def apply(self, points, *, out=None):
+    def apply(self, points, *, inverse=False, out=None):
         """Move points: ``R p + t``, shape (..., 3) broadcasting with the batch shape.
 
         ``T @ p`` is this. The last axis is the point, so a (3, 3) array holds three
         points, its rows (not the columns of a matrix product: for those write
-        ``(T.as_matrix() @ [[X], [1, 1, 1]])[:3]``).
+        ``(T.as_matrix() @ [[X], [1, 1, 1]])[:3]``). ``inverse=True`` applies the
+        inverse motion, ``R^T (p - t)`` (``T.inv() @ p``, without forming it), as
+        scipy's ``apply(..., inverse=True)``: ``p_B = A_T_B.apply(p_A, inverse=True)``.
+
+        >>> A_T_B = Transform(translation=[1.0, 0.0, 0.0])
+        >>> A_T_B.apply([0.0, 0.0, 0.0], inverse=True)
+        array([-1.,  0.,  0.])
         """
-        return _k.pose_apply(self._pose, as_array(points, (3,), "points"), out=out)
+        kern = _kpf.pose_apply_inverse if inverse else _k.pose_apply
+        return kern(self._pose, as_array(points, (3,), "points"), out=out)
 
     def inv(self):
         """Inverse transforms ``[R^T, -R^T t]`` (closed form, no matrix inverse)."""
@@ -183,6 +286,30 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
         """
         angle, dist = pose_gap(self._pose, other._pose)
         return (angle <= atol) & (dist <= atol)
+
+    def distance_to(self, other, *, rotation_weight=1.0, translation_weight=1.0):
+        """Weighted distance ``sqrt(a theta^2 + b |t2 - t1|^2)`` to ``other``, (...).
+
+        Of the relative motion ``self.inv() @ other`` (in the frame of ``self``):
+        ``theta`` its rotation angle (radians, [0, pi]), ``|R1^T (t2 - t1)| = |t2 -
+        t1|`` its translation length; ``a = rotation_weight``, ``b =
+        translation_weight`` (non-negative). Symmetric and invariant to a change of
+        the world frame. See :func:`rigidkit.se3.pose_distance`.
+
+        >>> A = Transform(translation=[3.0, 4.0, 0.0])
+        >>> float(A.distance_to(Transform()))
+        5.0
+        """
+        if not isinstance(other, Transform):
+            raise TypeError(
+                f"other must be a rigidkit.Transform, got {type(other).__name__}"
+            )
+        return _kpf.pose_distance(
+            _se3._weight(rotation_weight, "rotation_weight"),
+            _se3._weight(translation_weight, "translation_weight"),
+            self._pose,
+            other._pose,
+        )
 
     # -- powers and means (rigidkit.functional.interpolation / averaging) ---------------
     def __pow__(self, t):
