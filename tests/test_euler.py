@@ -607,8 +607,31 @@ def test_no_warning_for_nan_or_ordinary_batches(rng):
     with warnings.catch_warnings():
         warnings.simplefilter("error", GimbalLockWarning)
         R.as_euler("zxz")
-        euler.euler_from_quat("XYZ", np.full((3, 4), np.nan))
-        euler.euler_from_quat("XYZ", np.full(4, np.nan))
+        euler.euler_from_quat_unchecked("XYZ", np.full((3, 4), np.nan))
+        euler.euler_from_quat_unchecked("XYZ", np.full(4, np.nan))
+
+
+def test_public_euler_from_quat_validates():
+    """The public functional checks its quaternions (NaN, inf, zero), naming the
+    batch index, like every public conversion; the unchecked one passes NaN on."""
+    q = np.tile([1.0, 0.0, 0.0, 0.0], (3, 1))
+    q[2, 1] = np.nan
+    with pytest.raises(rk.NonFiniteError) as err:
+        euler.euler_from_quat("XYZ", q)
+    assert err.value.index == (2,)
+    assert np.isnan(euler.euler_from_quat_unchecked("XYZ", q)[2]).all()
+    q[2] = 0.0
+    with pytest.raises(rk.ZeroNormError) as err:
+        euler.euler_from_quat("zxz", q)
+    assert err.value.index == (2,)
+    # Any finite nonzero scale names a rotation: the angles of the unit quaternion.
+    q1 = rk.Rotation.from_rotvec([0.3, -0.2, 0.1]).as_quat()
+    np.testing.assert_allclose(
+        euler.euler_from_quat("ZYX", 1e-3 * q1),
+        euler.euler_from_quat_unchecked("ZYX", q1),
+        rtol=0,
+        atol=1e-15,
+    )
 
 
 @pytest.mark.parametrize("how", ["rotation", "functional", "matrix"])
@@ -878,7 +901,7 @@ BAD_SEQS = [
     "abc",
     "XYZX",
     "",
-    "xy",
+    "xx",  # one or two letters are from_euler sequences (scipy's), but not repeats
     "xxz",
     "zyy",
     "XyZ",

@@ -49,8 +49,15 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .._engine.namespace import is_float32, namespace_of
-from .._validate import batch_index, checks_now, finite_array, to_numpy, where_text
+from .._engine.namespace import is_float32, is_numpy, namespace_of
+from .._validate import (
+    as_array,
+    batch_index,
+    checks_now,
+    finite_array,
+    to_numpy,
+    where_text,
+)
 from ..errors import EulerSequenceError, GimbalLockWarning
 from ..kernels import euler as _k
 from . import conversions as _conv
@@ -60,6 +67,7 @@ __all__ = [
     "parse_sequence",
     "quat_from_euler",
     "euler_from_quat",
+    "euler_from_quat_unchecked",
     "matrix_from_euler",
     "euler_from_matrix",
     "gimbal_lock_threshold",
@@ -71,6 +79,7 @@ _ACCEPTED = (
     "axes: 'ZYX', 'XYZ', 'ZXZ', ...) or all lowercase (extrinsic, world axes: "
     "'zyx', 'xyz', 'zxz', ...), with no axis repeated in consecutive places"
 )
+_SHORT = "; from_euler also takes one or two letters ('z', 'ZY'), as scipy does"
 
 
 class EulerSequence(NamedTuple):
@@ -120,24 +129,61 @@ def parse_sequence(seq) -> EulerSequence:
     return parsed
 
 
-def _parse(seq) -> EulerSequence:
-    if not isinstance(seq, str):
-        raise EulerSequenceError(
-            f"Euler sequence must be a string, got {type(seq).__name__}; {_ACCEPTED}"
-        )
-    if len(seq) != 3:
-        raise EulerSequenceError(f"{seq!r} has {len(seq)} letters, not 3; {_ACCEPTED}")
+def parse_short_sequence(seq) -> tuple:
+    """``(parsed, n)``: a sequence of 1 to 3 letters, padded to three, and ``n``.
+
+    ``from_euler`` accepts one or two axes as scipy does (``"z"``, ``"zy"``,
+    ``"XY"``): the missing turns are turns by 0, about the axes that make a
+    Tait-Bryan sequence (``"zy"`` -> ``"zyx"``, ``"X"`` -> ``"XYZ"``), so the
+    kernels of the 24 sequences serve these too. A zero angle is exact (``cos 0 =
+    1``, ``sin 0 = 0``): the padded product is the product of the given turns.
+
+    >>> s, n = parse_short_sequence("zy")
+    >>> s.text, n
+    ('zyx', 2)
+    """
+    key = ("short", seq)
+    try:
+        return _PARSED[key]
+    except (KeyError, TypeError):
+        pass
+    if isinstance(seq, str) and 1 <= len(seq) <= 2:
+        _check_letters(seq, _ACCEPTED + _SHORT)
+        first = "xyz".index(seq[0].lower())
+        second = "xyz".index(seq[1].lower()) if len(seq) == 2 else (first + 1) % 3
+        rest = ("xyz"[second] if len(seq) == 1 else "") + "xyz"[3 - first - second]
+        parsed = (_parse(seq + (rest.upper() if seq.isupper() else rest)), len(seq))
+    else:
+        parsed = (_parse(seq, short=True), 3)
+    _PARSED[key] = parsed
+    return parsed
+
+
+def _check_letters(seq: str, accepted: str) -> None:
+    """One case, letters of xyz, no axis repeated consecutively (else the error)."""
     if seq.lower() != seq and seq.upper() != seq:
-        raise EulerSequenceError(f"{seq!r} mixes upper and lower case; {_ACCEPTED}")
+        raise EulerSequenceError(f"{seq!r} mixes upper and lower case; {accepted}")
     low = seq.lower()
     if any(c not in "xyz" for c in low):
-        raise EulerSequenceError(f"{seq!r} has letters other than x, y, z; {_ACCEPTED}")
-    if low[0] == low[1] or low[1] == low[2]:
+        raise EulerSequenceError(f"{seq!r} has letters other than x, y, z; {accepted}")
+    if any(low[i] == low[i + 1] for i in range(len(low) - 1)):
         raise EulerSequenceError(
             f"{seq!r} repeats an axis in consecutive places (two turns about one "
-            f"axis are one turn); {_ACCEPTED}"
+            f"axis are one turn); {accepted}"
         )
-    axes = tuple("xyz".index(c) for c in low)
+
+
+def _parse(seq, *, short=False) -> EulerSequence:
+    accepted = _ACCEPTED + (_SHORT if short else "")
+    if not isinstance(seq, str):
+        raise EulerSequenceError(
+            f"Euler sequence must be a string, got {type(seq).__name__}; {accepted}"
+        )
+    if len(seq) != 3:
+        want = "1 to 3" if short else "3"
+        raise EulerSequenceError(f"{seq!r} has {len(seq)} letters, not {want}; {accepted}")
+    _check_letters(seq, accepted)
+    axes = tuple("xyz".index(c) for c in seq.lower())
     intrinsic = seq.isupper()
     # Matrix-product order: R_e1 R_e2 R_e3. Intrinsic "IJK" is R_I R_J R_K with the
     # angles as given; extrinsic "ijk" is R_k R_j R_i, the angles reversed.
@@ -219,9 +265,12 @@ def quat_from_euler(seq, angles, *, degrees=False):
     Parameters
     ----------
     seq : str
-        Three letters of ``xyz`` (see :func:`parse_sequence`).
-    angles : array_like, shape (..., 3)
-        Angles in the order of ``seq``; radians, or degrees with ``degrees=True``.
+        Three letters of ``xyz`` (see :func:`parse_sequence`), or, as in scipy,
+        one or two (``"z"``, ``"zy"``, ``"XY"``: turns about those axes only, see
+        :func:`parse_short_sequence`).
+    angles : array_like, shape (..., n)
+        Angles in the order of ``seq``, ``n = len(seq)``; radians, or degrees with
+        ``degrees=True``. With one letter a scalar angle is accepted (shape ()).
     degrees : bool
 
     Returns
@@ -235,7 +284,7 @@ def quat_from_euler(seq, angles, *, degrees=False):
 
     See Also
     --------
-    euler_from_quat : the inverse.
+    euler_from_quat : the inverse (three-letter sequences only, as in scipy).
 
     Examples
     --------
@@ -243,11 +292,32 @@ def quat_from_euler(seq, angles, *, degrees=False):
     >>> q = quat_from_euler("XYZ", [np.pi / 2, 0.0, 0.0])
     >>> np.round(q, 12) + 0.0
     array([0.70710678, 0.70710678, 0.        , 0.        ])
+    >>> np.round(quat_from_euler("z", np.pi / 2), 12) + 0.0      # one axis
+    array([0.70710678, 0.        , 0.        , 0.70710678])
     """
-    s = parse_sequence(seq)
-    a = finite_array(angles, (3,), f"Euler angles for {seq!r}")
+    if isinstance(seq, str) and len(seq) == 3:
+        s, n = parse_sequence(seq), 3
+    else:
+        s, n = parse_short_sequence(seq)
+    what = f"Euler angles for {seq!r}"
+    if n == 3:
+        a = finite_array(angles, (3,), what)
+    else:
+        a = as_array(angles, (), what)
+        if n == 1 and a.ndim == 0:
+            a = a[None]
+        a = finite_array(a, (n,), what)
+        zero = namespace_of(a).zeros_like(a[..., :1])
+        a = _concat(a, [zero] * (3 - n))
     scale = math.pi / 180.0 if degrees else 1.0
     return _k.quat_from_euler(*s.params, scale, a)
+
+
+def _concat(a, extra):
+    """``a`` with the arrays ``extra`` appended along its last axis (any namespace)."""
+    if isinstance(a, np.ndarray) or is_numpy(namespace_of(a)):
+        return np.concatenate([a, *extra], axis=-1)
+    return namespace_of(a).concat([a, *extra], axis=-1)
 
 
 def euler_from_quat(seq, quat, *, degrees=False):
@@ -276,9 +346,11 @@ def euler_from_quat(seq, quat, *, degrees=False):
     seq : str
         Three letters of ``xyz`` (see :func:`parse_sequence`).
     quat : array_like, shape (..., 4)
-        Unit quaternions (as :class:`~rigidkit.Rotation` stores them). They are not
-        validated: normalise raw input with :func:`rigidkit.conversions.quat_normalize`
-        (a zero quaternion would give zero angles).
+        Quaternions of any finite nonzero scale (each names the rotation of
+        ``q / |q|``; the angles are computed from ``q`` itself, exactly, see
+        ``_checked_quat``). For quaternions known to be unit (a
+        :class:`~rigidkit.Rotation`'s) :func:`euler_from_quat_unchecked` skips the
+        checks.
     degrees : bool
 
     Returns
@@ -287,6 +359,14 @@ def euler_from_quat(seq, quat, *, degrees=False):
         In the order of ``seq``. First and third angle in (-pi, pi]; the middle in
         [0, pi] for proper sequences, [-pi/2, pi/2] for Tait-Bryan ones (degrees:
         (-180, 180], [0, 180], [-90, 90]).
+
+    Raises
+    ------
+    EulerSequenceError, ShapeError
+    NonFiniteError, ZeroNormError
+        For a quaternion with NaN or infinite components, or a zero one, naming
+        its batch index (skipped where values cannot be read, e.g. under
+        ``jax.jit``, where NaN propagates).
 
     Warns
     -----
@@ -318,6 +398,46 @@ def euler_from_quat(seq, quat, *, degrees=False):
     ...     angles = euler_from_quat("ZYX", q_lock, degrees=True)
     >>> caught[0].category.__name__, angles + 0.0
     ('GimbalLockWarning', array([ 0., 90.,  0.]))
+    """
+    s = parse_sequence(seq)  # the sequence first: its error is the likelier one
+    return euler_from_quat_unchecked(s.text, _checked_quat(quat), degrees=degrees)
+
+
+def _checked_quat(quat):
+    """``quat`` validated (finite, nonzero), itself where its scale is moderate.
+
+    The kernel is homogeneous of degree 0, so the angles returned are those of the
+    quaternion given, to the last bit near the lock too, where normalising first
+    (one rounding of each component) would move the first and third angle by
+    ``eps / distance`` (6e-9 rad at 1e-9 from the lock). Its lock test multiplies
+    four components, though, so a quaternion whose squared norm is outside
+    ``[1e-140, 1e140]`` (float32: ``[1e-16, 1e16]``) is replaced by its unit one.
+    """
+    q = as_array(quat, (4,), "quaternion")
+    unit = _conv.quat_normalize(q)  # raises for NaN, inf or zero, naming the index
+    if isinstance(q, np.ndarray) and q.dtype.kind != "f":
+        return unit
+    xp = namespace_of(q)
+    lim = 1e16 if is_float32(q.dtype) else 1e140
+    n2 = xp.sum(q * q, axis=-1)
+    moderate = (n2 < lim) & (n2 > 1.0 / lim)
+    if isinstance(moderate, np.ndarray) and moderate.all():
+        return q
+    return xp.where(moderate[..., None], q, unit)
+
+
+def euler_from_quat_unchecked(seq, quat, *, degrees=False):
+    """:func:`euler_from_quat` for unit quaternions, without normalising or checks.
+
+    The quaternions are taken as they are (the object layer's, unit by
+    construction): NaN gives NaN angles, never an error; the kernel is homogeneous
+    of degree 0, so a moderately scaled ``q`` gives its rotation's angles and a
+    zero one zero angles. Same conventions, ranges and gimbal-lock warning.
+
+    >>> import numpy as np
+    >>> q = np.array([np.sqrt(0.5), 0.0, 0.0, np.sqrt(0.5)])  # a quarter turn about z
+    >>> np.round(euler_from_quat_unchecked("ZYX", q), 12) + 0.0
+    array([1.57079633, 0.        , 0.        ])
     """
     s = parse_sequence(seq)
     scale = 180.0 / math.pi if degrees else 1.0
@@ -364,7 +484,8 @@ def euler_from_matrix(seq, matrix, *, degrees=False, atol=None):
     >>> np.round(euler_from_matrix("XYZ", Rz, degrees=True), 12) + 0.0
     array([ 0.,  0., 90.])
     """
-    return euler_from_quat(seq, _conv.quat_from_matrix(matrix, atol=atol), degrees=degrees)
+    q = _conv.quat_from_matrix(matrix, atol=atol)  # validated, unit
+    return euler_from_quat_unchecked(seq, q, degrees=degrees)
 
 
 def _warn_if_locked(s: EulerSequence, angles, scale: float) -> None:

@@ -121,14 +121,18 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
 
     @classmethod
     def from_euler(cls, seq, angles, *, degrees=False):
-        """From Euler angles, shape (..., 3).
+        """From Euler angles, shape (..., n) for a sequence of ``n`` letters.
 
-        ``seq``: three letters of ``xyz``; UPPERCASE = intrinsic (body axes),
-        lowercase = extrinsic (world axes). ``"ZYX"`` is yaw-pitch-roll.
+        ``seq``: three letters of ``xyz``, or one or two as in scipy (``"z"``,
+        ``"zy"``; with one letter a scalar angle is accepted); UPPERCASE =
+        intrinsic (body axes), lowercase = extrinsic (world axes). ``"ZYX"`` is
+        yaw-pitch-roll. :meth:`as_euler` takes three letters (as scipy's).
 
         >>> R = Rotation.from_euler("ZYX", [90.0, 0.0, 0.0], degrees=True)
         >>> np.round(R.as_rotvec(), 12) + 0.0
         array([0.        , 0.        , 1.57079633])
+        >>> R.approx_equal(Rotation.from_euler("z", 90.0, degrees=True))
+        True
         """
         return cls._wrap(euler.quat_from_euler(seq, angles, degrees=degrees))
 
@@ -197,7 +201,7 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
         degrees: see :func:`rigidkit.euler.euler_from_quat`); the angles always
         rebuild the rotation.
         """
-        return euler.euler_from_quat(seq, self._quat, degrees=degrees)
+        return euler.euler_from_quat_unchecked(seq, self._quat, degrees=degrees)
 
     @property
     def angle(self):
@@ -212,12 +216,15 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
     # -- group operations ----------------------------------------------------------
     # ``R1 @ R2`` composes (``R2`` first), ``R @ v`` rotates vectors and ``compose``
     # takes an ``out=`` buffer: Group, with the Hamilton product as _compose_kernel.
-    def apply(self, vectors, *, out=None):
+    def apply(self, vectors, *, inverse=False, out=None):
         """Rotate vectors, shape (..., 3) broadcasting with the rotation's shape.
 
         ``R @ v`` is this. The last axis is the vector, so a (3, 3) array ``X`` is
         three vectors, its rows: ``R @ X == X @ R.as_matrix().T``. The matrix
         product, which rotates the columns, is spelled ``R.as_matrix() @ X``.
+        ``inverse=True`` applies the inverse rotation, ``R^T v`` (``v_B = B_R_A
+        v_A`` from ``A_R_B``), as scipy's ``apply(v, inverse=True)``; ``out`` is a
+        NumPy buffer of shape (..., 3) for the result.
 
         >>> R = Rotation.from_rotvec([0.0, 0.0, np.pi / 2])
         >>> X = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]) + 1.0
@@ -231,7 +238,8 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
                [ 1.,  1.,  2.]])
         """
         v = as_array(vectors, (3,), "vectors")
-        return _conv.quat_apply_unchecked(self._quat, v, out=out)
+        q = _conv.quat_conjugate(self._quat) if inverse else self._quat
+        return _conv.quat_apply_unchecked(q, v, out=out)
 
     def inv(self):
         """Inverse rotations (conjugate quaternions)."""
