@@ -472,3 +472,36 @@ def test_references_see_the_reported_errors(references):
     x0, kinds, _, J_ref, _ = references["Quaternion.log"]
     p = kinds.index("zero")
     np.testing.assert_allclose(J_ref[p][1:, 1:], np.eye(3) / x0[p, 0], atol=1e-8)
+
+
+def test_jax_forward_mode_with_concrete_operands(jax, rng):
+    """Eager ``jax.jacfwd`` (what ``jax.hessian`` runs last) where concrete JAX arrays
+    meet traced ones: a fixed rotation or pose applied to a traced vector, a traced
+    rotation applied to a fixed vector or composed with a fixed one (once an
+    ``AttributeError``, 'SingleDeviceSharding' object has no attribute 'spec':
+    ``device=`` of a tracer). References: the matrix from scipy (d(R v)/dv = R) and
+    central differences of the NumPy path."""
+    jnp = jax.numpy
+    q, q2 = quats(rng, ("random", "random"))
+    v, t = rng.standard_normal((2, 3))
+    M = SciRotation.from_quat(q, scalar_first=True).as_matrix()
+    R_fixed = R.from_quat(jnp.asarray(q))  # concrete, on the default device
+
+    J = jax.jacfwd(lambda v: R_fixed.apply(v))(jnp.asarray(v))
+    np.testing.assert_allclose(np.asarray(J), M, atol=1e-12)
+    T_fixed = T(R_fixed, jnp.asarray(t))
+    J = jax.jacfwd(lambda p: T_fixed.apply(p))(jnp.asarray(v))
+    np.testing.assert_allclose(np.asarray(J), M, atol=1e-12)
+
+    def rotated(q):
+        return R.from_quat(q).apply(jnp.asarray(v))  # traced rotation, concrete vector
+
+    op = Op("from_quat(q).apply(v)", lambda x: R.from_quat(x).apply(v), None)
+    J_fd = fd_jacobian(op, q2[None], ("random",))[0]
+    J = jax.jacfwd(rotated)(jnp.asarray(q2))
+    np.testing.assert_allclose(np.asarray(J), J_fd, atol=1e-8)
+
+    op = Op("R_fixed @ R(q)", lambda x: (R.from_quat(q) @ R.from_quat(x)).as_quat(), None)
+    J_fd = fd_jacobian(op, q2[None], ("random",))[0]
+    J = jax.jacfwd(lambda x: (R_fixed @ R.from_quat(x)).as_quat())(jnp.asarray(q2))
+    np.testing.assert_allclose(np.asarray(J), J_fd, atol=1e-8)
