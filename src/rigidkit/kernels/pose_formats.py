@@ -32,9 +32,13 @@ def exp_coords_from_pose(w, x, y, z, tx, ty, tz):
 
 @kernel(inputs=[(7,)], outputs=[(7,), ()])
 def pose_from_pq(tx, ty, tz, qw, qx, qy, qz):
-    """Pose of ``(tx, ty, tz, qw, qx, qy, qz)``, the quaternion normalised; and ``|q|``."""
+    """Pose of ``(tx, ty, tz, qw, qx, qy, qz)``, the quaternion normalised; a check.
+
+    The check is ``|q| + 0 t``: positive and finite exactly when ``q`` is nonzero and
+    every component finite (as in :func:`.dual_quaternion.pose_from_dual_quat`).
+    """
     w, x, y, z, n = quat_normalize(qw, qx, qy, qz)
-    return (w, x, y, z, tx, ty, tz, n)
+    return (w, x, y, z, tx, ty, tz, n + 0.0 * tx + 0.0 * ty + 0.0 * tz)
 
 
 @kernel(inputs=[(7,)], outputs=[(7,), ()])
