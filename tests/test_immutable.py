@@ -54,6 +54,7 @@ def args_for(obj, name):
         "plus": (np.full(getattr(obj, "dof", 3), 0.1),),
         "minus": (obj,),
         "approx_equal": (obj,),
+        "distance_to": (obj,),
         "compose": (obj,),
         "reshape": (obj.shape,),
     }
