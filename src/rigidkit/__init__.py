@@ -53,6 +53,7 @@ _LAZY = {
     "align_vectors": ("applications.alignment", "align_vectors"),
     "align_points": ("applications.alignment", "align_points"),
     "kinematics": ("applications.kinematics", None),
+    "jacobians": ("applications.jacobians", None),
 }
 
 # The public module paths predate the layered tree (docs/architecture.md):
@@ -74,6 +75,7 @@ _MODULE_ALIASES = {
     },
     "symbolic": "applications.symbolic",
     "kinematics": "applications.kinematics",
+    "jacobians": "applications.jacobians",
     "cli": "applications.cli",
 }
 
@@ -143,6 +145,7 @@ __all__ = [
     "sim3",
     "symbolic",
     "kinematics",
+    "jacobians",
     # the validation switch (docs/architecture.md, "Validation policy")
     "set_validation",
     # errors and warnings
