@@ -193,6 +193,25 @@ def omega_from_quat_derivative(body, w, x, y, z, dw, dx, dy, dz):
 # -- homogeneous transforms and twists ----------------------------------------------------
 
 
+@helper
+def derivative_of_homogeneous(body, r, k, ux, uy, uz, px, py, pz):
+    """Row-major ``[[k, t], [0, 0]]`` with ``t = R u`` (body) or ``p + u`` (world).
+
+    The common form of ``T'`` and ``T''`` in either frame: ``k`` is their rotation
+    block, ``r`` the rotation ``R`` of ``T``, both row-major.
+    """
+    b = body == 1
+    tx = where(b, r[0] * ux + r[1] * uy + r[2] * uz, px + ux)
+    ty = where(b, r[3] * ux + r[4] * uy + r[5] * uz, py + uy)
+    tz = where(b, r[6] * ux + r[7] * uy + r[8] * uz, pz + uz)
+    return (
+        k[0], k[1], k[2], tx,
+        k[3], k[4], k[5], ty,
+        k[6], k[7], k[8], tz,
+        0.0, 0.0, 0.0, 0.0,
+    )  # fmt: skip
+
+
 @kernel(inputs=[(4, 4), (4, 4)], outputs=[(6,)], params=("body",))
 def twist_from_matrix_derivative(
     body,
@@ -237,16 +256,7 @@ def matrix_second_derivative_from_twist(
     uz = dvz + cz
     # translation column: world (hat(a) + hat(w)^2) p + u, body R u
     px, py, pz = hat_sq_apply(wx, wy, wz, ax, ay, az, m03, m13, m23)
-    b = body == 1
-    tx = where(b, m00 * ux + m01 * uy + m02 * uz, px + ux)
-    ty = where(b, m10 * ux + m11 * uy + m12 * uz, py + uy)
-    tz = where(b, m20 * ux + m21 * uy + m22 * uz, pz + uz)
-    return (
-        k[0], k[1], k[2], tx,
-        k[3], k[4], k[5], ty,
-        k[6], k[7], k[8], tz,
-        0.0, 0.0, 0.0, 0.0,
-    )  # fmt: skip
+    return derivative_of_homogeneous(body, r, k, ux, uy, uz, px, py, pz)
 
 
 @kernel(inputs=[(4, 4), (6,)], outputs=[(4, 4)], params=("body",))
@@ -262,16 +272,7 @@ def matrix_derivative_from_twist(
     r = (m00, m01, m02, m10, m11, m12, m20, m21, m22)
     k = left_or_right_apply(body, 0.0, 0.0, 0.0, wx, wy, wz, r)
     cx, cy, cz = cross3(wx, wy, wz, m03, m13, m23)
-    b = body == 1
-    tx = where(b, m00 * vx + m01 * vy + m02 * vz, cx + vx)
-    ty = where(b, m10 * vx + m11 * vy + m12 * vz, cy + vy)
-    tz = where(b, m20 * vx + m21 * vy + m22 * vz, cz + vz)
-    return (
-        k[0], k[1], k[2], tx,
-        k[3], k[4], k[5], ty,
-        k[6], k[7], k[8], tz,
-        0.0, 0.0, 0.0, 0.0,
-    )  # fmt: skip
+    return derivative_of_homogeneous(body, r, k, vx, vy, vz, cx, cy, cz)
 
 
 @kernel(inputs=[(6,), (6,)], outputs=[(4, 4)])

@@ -51,6 +51,23 @@ def euler_product_order(reverse, a0, a1, a2):
 
 
 @helper
+def body_or_world(body, bod, world):
+    """The 9 entries ``bod`` for ``body == 1``, else ``world``."""
+    b = body == 1
+    return (
+        where(b, bod[0], world[0]),
+        where(b, bod[1], world[1]),
+        where(b, bod[2], world[2]),
+        where(b, bod[3], world[3]),
+        where(b, bod[4], world[4]),
+        where(b, bod[5], world[5]),
+        where(b, bod[6], world[6]),
+        where(b, bod[7], world[7]),
+        where(b, bod[8], world[8]),
+    )
+
+
+@helper
 def euler_rate_columns(parity, proper, body, t1, t2, t3):
     """The 9 entries of ``E`` in permuted coordinates, column by column (product order).
 
@@ -73,18 +90,7 @@ def euler_rate_columns(parity, proper, body, t1, t2, t3):
         where(pr, 0.0, s3), c3, where(pr, -s3, 0.0),
         where(pr, 1.0, 0.0), 0.0, where(pr, 0.0, 1.0),
     )  # fmt: skip
-    b = body == 1
-    return (
-        where(b, bod[0], world[0]),
-        where(b, bod[1], world[1]),
-        where(b, bod[2], world[2]),
-        where(b, bod[3], world[3]),
-        where(b, bod[4], world[4]),
-        where(b, bod[5], world[5]),
-        where(b, bod[6], world[6]),
-        where(b, bod[7], world[7]),
-        where(b, bod[8], world[8]),
-    )
+    return body_or_world(body, bod, world)
 
 
 @helper
@@ -161,19 +167,7 @@ def euler_rate_inverse_rows(parity, proper, body, t1, t2, t3):
         where(pr, 1.0, -s2 * c3 * k), where(pr, -c2 * s3 * k, s2 * s3 * k),
         where(pr, -c2 * c3 * k, 1.0),
     )  # fmt: skip
-    b = body == 1
-    return (
-        where(b, bod[0], world[0]),
-        where(b, bod[1], world[1]),
-        where(b, bod[2], world[2]),
-        where(b, bod[3], world[3]),
-        where(b, bod[4], world[4]),
-        where(b, bod[5], world[5]),
-        where(b, bod[6], world[6]),
-        where(b, bod[7], world[7]),
-        where(b, bod[8], world[8]),
-        d,
-    )
+    return body_or_world(body, bod, world) + (d,)
 
 
 @helper
