@@ -56,11 +56,15 @@ def _loop_key(params) -> str:
     return "(dt, (" + "".join(f"isinstance({p}, INTS), " for p in params) + "))"
 
 
-def _run_single(outs, args) -> list[str]:
-    """Lines that run the one-element ``loop`` into fresh outputs or a fitting ``out=``."""
+def _run_loop(outs, args, shape_source) -> list[str]:
+    """Lines that run ``loop`` into fresh outputs or a fitting ``out=``.
+
+    ``shape_source(s)``: the source of the whole shape of an output of trailing
+    shape ``s`` (a constant for one element, ``(n, *s)`` for a batch).
+    """
     onames = [f"o{k}" for k in range(len(outs))]
     lines = ["if out is None:"]
-    lines += [f"    {o} = empty({tuple(s)!r}, dt)" for o, s in zip(onames, outs)]
+    lines += [f"    {o} = empty({shape_source(s)}, dt)" for o, s in zip(onames, outs)]
     lines.append(f"    loop({', '.join(args + onames)})")
     lines.append(
         f"    return {onames[0]}"
@@ -70,11 +74,16 @@ def _run_single(outs, args) -> list[str]:
     if len(outs) == 1:
         lines.append(
             "if type(out) is ndarray and out.dtype is dt and out.shape == "
-            f"{tuple(outs[0])!r} and out.flags.c_contiguous:"
+            f"{shape_source(outs[0])} and out.flags.c_contiguous:"
         )
         lines.append(f"    loop({', '.join(args)}, out)")
         lines.append("    return out")
     return lines
+
+
+def _run_single(outs, args) -> list[str]:
+    """:func:`_run_loop` of the one-element loop: the output shapes are constants."""
+    return _run_loop(outs, args, lambda s: repr(tuple(s)))
 
 
 def fast_source(kernel, has_single=False) -> str:
@@ -189,22 +198,5 @@ def _shape_n(shape) -> str:
 
 
 def _run_batch(outs, args) -> list[str]:
-    """Lines that run ``loop`` into fresh outputs or a fitting ``out=``."""
-    onames = [f"o{k}" for k in range(len(outs))]
-    lines = ["if out is None:"]
-    for o, s in zip(onames, outs):
-        lines.append(f"    {o} = empty({_shape_n(s)}, dt)")
-    lines.append(f"    loop({', '.join(args + onames)})")
-    lines.append(
-        f"    return {onames[0]}"
-        if len(outs) == 1
-        else f"    return ({', '.join(onames)},)"
-    )
-    if len(outs) == 1:
-        lines.append(
-            "if type(out) is ndarray and out.dtype is dt and out.shape == "
-            f"{_shape_n(outs[0])} and out.flags.c_contiguous:"
-        )
-        lines.append(f"    loop({', '.join(args)}, out)")
-        lines.append("    return out")
-    return lines
+    """:func:`_run_loop` of the batch loop: outputs of shape ``(n, *trail)``."""
+    return _run_loop(outs, args, _shape_n)
