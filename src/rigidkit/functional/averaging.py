@@ -266,6 +266,58 @@ def _check_count(q, what):
         raise DegenerateInputError(f"the mean of zero {what} is undefined")
 
 
+def _grouped_weighted(xp, x, weights, axis, what):
+    """``x`` (..., c) grouped (kept, K, c) over the reduced axes; weights and sums."""
+    axes = reduce_axes(axis, x.ndim - 1)
+    g, _ = _grouped(xp, x, axes, 1)
+    _check_count(g, what)
+    w, total = _weights(xp, weights, tuple(x.shape[:-1]), axes, x)
+    return g, w, total
+
+
+def _karcher(xp, mean, g, w, total, method, tol, max_iter, steps):
+    """``(mean, iterations)``: the Karcher fixed point from the chordal ``mean``.
+
+    For ``method="chordal"`` the chordal mean itself (0 iterations). ``steps`` is
+    the group's ``(log_from, retract)``: ``log_from(mean, g)`` the tangents
+    ``log(mean^-1 g_i)`` (kept, K, c) and ``retract(mean, step) = mean exp(step)``.
+    """
+    if method == "chordal":
+        return mean, 0
+    if method != "geodesic":
+        raise ValueError(f"method must be 'chordal' or 'geodesic', got {method!r}")
+    log_from, retract = steps
+    tol = _tol(tol, g.dtype)
+    for iterations in range(1, max_iter + 1):
+        step = _average(xp, log_from(mean, g), w, total)
+        mean = retract(mean, step)
+        if _converged(xp, step, tol):
+            return mean, iterations
+    _warn_unconverged(max_iter, tol)
+    return mean, max_iter
+
+
+def _quat_log_from(mean, q):
+    rel = _kq.quat_multiply(_kq.quat_conjugate(mean[..., None, :]), q)
+    return _krv.rotvec_from_quat(rel)
+
+
+def _quat_retract(mean, step):
+    return _kq.quat_multiply(mean, _krv.quat_from_rotvec(step))
+
+
+def _pose_log_from(mean, p):
+    return _kse3.twist_from_pose(_kse3.pose_compose(_kse3.pose_inv(mean)[..., None, :], p))
+
+
+def _pose_retract(mean, step):
+    return _kse3.pose_compose(mean, _kse3.pose_from_twist(step))
+
+
+_SO3_STEPS = (_quat_log_from, _quat_retract)
+_SE3_STEPS = (_pose_log_from, _pose_retract)
+
+
 def quat_mean(quats, weights=None, *, method="chordal", axis=None, tol=None, max_iter=100):
     """Mean rotation of unit quaternions, along batch axes.
 
@@ -311,27 +363,12 @@ def quat_mean_unchecked(
     The weights are still validated. :meth:`rigidkit.Rotation.mean` calls this.
     """
     xp = namespace_of(q)
-    axes = reduce_axes(axis, q.ndim - 1)
-    batch = tuple(q.shape[:-1])
-    g, kept = _grouped(xp, q, axes, 1)
-    _check_count(g, "rotations")
-    w, total = _weights(xp, weights, batch, axes, q)
+    g, w, total = _grouped_weighted(xp, q, weights, axis, "rotations")
     if g.shape[-2] == 1 and method in ("chordal", "geodesic"):
         return _kq.quat_canonical(g[..., 0, :]), 0  # the mean of one rotation
-    mean = _chordal(xp, g, w)
-    iterations = 0
-    if method == "geodesic":
-        tol = _tol(tol, q.dtype)
-        for iterations in range(1, max_iter + 1):  # noqa: B007
-            rel = _kq.quat_multiply(_kq.quat_conjugate(mean[..., None, :]), g)
-            step = _average(xp, _krv.rotvec_from_quat(rel), w, total)
-            mean = _kq.quat_multiply(mean, _krv.quat_from_rotvec(step))
-            if _converged(xp, step, tol):
-                break
-        else:
-            _warn_unconverged(max_iter, tol)
-    elif method != "chordal":
-        raise ValueError(f"method must be 'chordal' or 'geodesic', got {method!r}")
+    mean, iterations = _karcher(
+        xp, _chordal(xp, g, w), g, w, total, method, tol, max_iter, _SO3_STEPS
+    )
     return (_kq.quat_canonical(mean) if iterations else mean), iterations
 
 
@@ -357,26 +394,10 @@ def pose_mean_unchecked(
 ):
     """:func:`pose_mean` of poses with unit quaternions, finite (not checked)."""
     xp = namespace_of(p)
-    axes = reduce_axes(axis, p.ndim - 1)
-    batch = tuple(p.shape[:-1])
-    g, kept = _grouped(xp, p, axes, 1)
-    _check_count(g, "poses")
-    w, total = _weights(xp, weights, batch, axes, p)
+    g, w, total = _grouped_weighted(xp, p, weights, axis, "poses")
     t = _average(xp, g[..., 4:], w, total)
     mean = xp.concat([_chordal(xp, g[..., :4], w), t], axis=-1)
-    iterations = 0
-    if method == "geodesic":
-        tol = _tol(tol, p.dtype)
-        for iterations in range(1, max_iter + 1):  # noqa: B007
-            rel = _kse3.pose_compose(_kse3.pose_inv(mean)[..., None, :], g)
-            step = _average(xp, _kse3.twist_from_pose(rel), w, total)
-            mean = _kse3.pose_compose(mean, _kse3.pose_from_twist(step))
-            if _converged(xp, step, tol):
-                break
-        else:
-            _warn_unconverged(max_iter, tol)
-    elif method != "chordal":
-        raise ValueError(f"method must be 'chordal' or 'geodesic', got {method!r}")
+    mean, iterations = _karcher(xp, mean, g, w, total, method, tol, max_iter, _SE3_STEPS)
     return xp.concat(
         [_kq.quat_canonical(mean[..., :4]), mean[..., 4:]], axis=-1
     ), iterations
@@ -404,5 +425,5 @@ def _warn_unconverged(max_iter, tol):
         f"the Karcher mean did not converge to {tol:g} in {max_iter} steps "
         "(the data may be spread over more than a hemisphere); returning the last iterate",
         ConvergenceWarning,
-        stacklevel=3,
+        stacklevel=4,
     )

@@ -297,30 +297,9 @@ def bspline_so3_eval(quats, dt, t0, query, order):
     array, shape (q, ..., 4) for order 0, else (q, ..., 3)
         Quaternions, body angular velocity (rad per time unit) or acceleration.
     """
-    n = quats.shape[0]
-    xp, seg, u = _bspline_setup(n, dt, t0, query, quats)
+    xp, seg, u = _bspline_setup(quats.shape[0], dt, t0, query, quats)
     d_all = _relative_rotvecs(quats)
-    u = _expand(u, quats.ndim - 2)
-    l, dl, ddl = bspline_basis(u)
-    dev = device_of(quats)
-    q = _take(xp, quats, seg, dev)
-    w = dw = None
-    for j in range(3):
-        d = _take(xp, d_all, seg + j, dev)
-        a = _krv.quat_from_rotvec(l[..., j : j + 1] * d)
-        q = _kq.quat_multiply(q, a)
-        if order == 0:
-            continue
-        vel = dl[..., j : j + 1] * d
-        if w is None:
-            w, dw = vel, ddl[..., j : j + 1] * d
-            continue
-        a_inv = _kq.quat_conjugate(a)
-        w = _kq.quat_apply(a_inv, w) + vel
-        dw = _kq.quat_apply(a_inv, dw) + ddl[..., j : j + 1] * d + _jac.bracket(w, vel)
-    if order == 0:
-        return q
-    return w / dt if order == 1 else dw / (dt * dt)
+    return _cumulative_eval(xp, quats, d_all, seg, u, dt, order, _SO3_OPS)
 
 
 def bspline_se3_eval(poses, dt, t0, query, order):
@@ -329,27 +308,61 @@ def bspline_se3_eval(poses, dt, t0, query, order):
     As :func:`bspline_so3_eval` with poses ``(n, ..., 7)``; the rates are body
     twists ``(v, w)`` (``T^-1 dT/dt``) and their derivatives.
     """
-    n = poses.shape[0]
-    xp, seg, u = _bspline_setup(n, dt, t0, query, poses)
+    xp, seg, u = _bspline_setup(poses.shape[0], dt, t0, query, poses)
     d_all = _kse3.twist_from_pose(_kse3.pose_compose(_kse3.pose_inv(poses[:-1]), poses[1:]))
-    u = _expand(u, poses.ndim - 2)
+    return _cumulative_eval(xp, poses, d_all, seg, u, dt, order, _SE3_OPS)
+
+
+def _cumulative_eval(xp, ctrl, d_all, seg, u, dt, order, ops):
+    """The B-spline value or body rate of the module doc, on one group.
+
+    ``ctrl`` are the control elements (n, ..., k), ``d_all`` their relative
+    tangents ``log(X_{k-1}^-1 X_k)``, ``seg`` and ``u`` the segment and position of
+    each query (:func:`_bspline_setup`). ``ops`` are the group's ``(exp, compose,
+    inverse_adjoint, apply_adjoint, bracket)``: ``apply_adjoint(inverse_adjoint(A),
+    w) = Ad(A^-1) w``, the inverse formed once per factor.
+    """
+    exp, compose, inverse_adjoint, apply_adjoint, bracket = ops
+    u = _expand(u, ctrl.ndim - 2)
     l, dl, ddl = bspline_basis(u)
-    dev = device_of(poses)
-    p = _take(xp, poses, seg, dev)
+    dev = device_of(ctrl)
+    x = _take(xp, ctrl, seg, dev)
     w = dw = None
     for j in range(3):
         d = _take(xp, d_all, seg + j, dev)
-        a = _kse3.pose_from_twist(l[..., j : j + 1] * d)
-        p = _kse3.pose_compose(p, a)
+        a = exp(l[..., j : j + 1] * d)
+        x = compose(x, a)
         if order == 0:
             continue
         vel = dl[..., j : j + 1] * d
         if w is None:
             w, dw = vel, ddl[..., j : j + 1] * d
             continue
-        ad_inv = _kse3.adjoint_from_pose(_kse3.pose_inv(a))
-        w = _matvec(ad_inv, w) + vel
-        dw = _matvec(ad_inv, dw) + ddl[..., j : j + 1] * d + _kse3.bracket(w, vel)
+        ad_inv = inverse_adjoint(a)
+        w = apply_adjoint(ad_inv, w) + vel
+        dw = apply_adjoint(ad_inv, dw) + ddl[..., j : j + 1] * d + bracket(w, vel)
     if order == 0:
-        return p
+        return x
     return w / dt if order == 1 else dw / (dt * dt)
+
+
+def _pose_inverse_adjoint(pose):
+    return _kse3.adjoint_from_pose(_kse3.pose_inv(pose))
+
+
+# (exp, compose, inverse_adjoint, apply_adjoint, bracket) of :func:`_cumulative_eval`;
+# on SO(3) ``Ad(A^-1)`` is the rotation ``A^-1``, kept as the conjugate quaternion.
+_SO3_OPS = (
+    _krv.quat_from_rotvec,
+    _kq.quat_multiply,
+    _kq.quat_conjugate,
+    _kq.quat_apply,
+    _jac.bracket,
+)
+_SE3_OPS = (
+    _kse3.pose_from_twist,
+    _kse3.pose_compose,
+    _pose_inverse_adjoint,
+    _matvec,
+    _kse3.bracket,
+)
