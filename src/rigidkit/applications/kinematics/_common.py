@@ -30,24 +30,27 @@ def body_flag(frame, fn: str) -> int:
     raise FrameError(f"{fn}: frame must be {_FRAMES}; got {frame!r}")
 
 
+def _matrix(x, cls, trail, what, check):
+    """The matrix of a ``cls`` object, or ``x`` as a finite array checked by ``check``.
+
+    ``check`` raises with the batch index where a matrix is outside the group
+    (the conversions do); the matrix itself is used as given.
+    """
+    if isinstance(x, cls):
+        return x.as_matrix()
+    m = finite_array(x, trail, what)
+    check(m)
+    return m
+
+
 def rotation_matrix(R, what: str = "rotation matrix"):
     """Rotation matrices (..., 3, 3) of a :class:`Rotation` or an array, validated."""
-    if isinstance(R, Rotation):
-        return R.as_matrix()
-    # quat_from_matrix raises NotARotationError (with the batch index) for a
-    # matrix outside SO(3); the matrix itself is used as given.
-    m = finite_array(R, (3, 3), what)
-    _conv.quat_from_matrix(m)
-    return m
+    return _matrix(R, Rotation, (3, 3), what, _conv.quat_from_matrix)
 
 
 def homogeneous_matrix(T, what: str = "homogeneous matrix"):
     """Homogeneous matrices (..., 4, 4) of a :class:`Transform` or an array, validated."""
-    if isinstance(T, Transform):
-        return T.as_matrix()
-    m = finite_array(T, (4, 4), what)
-    _se3.pose_from_matrix(m)
-    return m
+    return _matrix(T, Transform, (4, 4), what, _se3.pose_from_matrix)
 
 
 def quaternion(q, what: str = "quaternion"):
