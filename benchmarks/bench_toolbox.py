@@ -16,7 +16,9 @@ the op) on
   on their signs: marked);
 * ``align_vectors``: N independent problems of 20 vector pairs (scipy and the
   others solve one problem per call: a Python loop over the problems, timed at
-  N <= 10,000 only).
+  N <= 10,000 only);
+* ``from_dual_quat`` / ``as_dual_quat``: N rigid motions from and to unit dual
+  quaternions (scipy's ``RigidTransform``, scipy >= 1.16), both scalar first.
 
 Numbers are ns per element (per rotation, time or problem) for a batch and us per
 call for N = 1, medians of round-robin samples (see ``_common.py``).
@@ -113,6 +115,7 @@ class Data:
     a: np.ndarray  # (N, PAIRS, 3) or (PAIRS, 3)
     b: np.ndarray
     objects: dict = field(default_factory=dict)
+    dq: np.ndarray | None = None  # unit dual quaternions (q_r, q_d), scalar first
 
 
 def make_data(n, libs, seed=0) -> Data:
@@ -133,7 +136,11 @@ def make_data(n, libs, seed=0) -> Data:
     R = libs.st.Rotation.from_quat(unit_quats(rng, (max(n, 1),)), scalar_first=True)
     a = np.einsum("nij,nkj->nki", R.as_matrix(), b.reshape(-1, PAIRS, 3)).reshape(b.shape)
     a += 1e-3 * rng.standard_normal(a.shape)
-    return Data(n, single, q1, q2, t, cl, times, keys, a, b)
+    rk = libs.rk
+    motion = rk.Transform(
+        rk.Rotation.from_quat(q1), 3.0 * rng.standard_normal(shape + (3,))
+    )
+    return Data(n, single, q1, q2, t, cl, times, keys, a, b, dq=motion.as_dual_quat())
 
 
 def build_rows(libs: Libs) -> list:
@@ -258,6 +265,22 @@ def build_rows(libs: Libs) -> list:
 
     r.notes["scipy"] = "one call per problem (a Python loop for a batch)"
     r.impls["scipy"] = scipy_align
+
+    # dual quaternions (scipy's RigidTransform, scipy >= 1.16) --------------------------
+    ST = getattr(st, "RigidTransform", None)
+    r = C.Row("from_dual_quat", ((8,), 7), False, "tf")
+    rows.append(r)
+    r.impls["rigidkit"] = lambda d: partial(rk.Transform.from_dual_quat, d.dq)
+    r = C.Row("as_dual_quat", ((7,), 8), False, "dq")
+    rows.append(r)
+    r.impls["rigidkit"] = lambda d: rk.Transform.from_dual_quat(d.dq).as_dual_quat
+    if ST is not None:
+        rows[-2].impls["scipy"] = lambda d: partial(
+            ST.from_dual_quat, d.dq, scalar_first=True
+        )
+        r.impls["scipy"] = lambda d: partial(
+            ST.from_dual_quat(d.dq, scalar_first=True).as_dual_quat, scalar_first=True
+        )
     return rows
 
 
@@ -268,6 +291,12 @@ def canonical(kind, lib, x, libs):
         return None
     if kind == "vec":
         return np.asarray(x)
+    if kind == "tf":  # a rigid motion of either library: its 4x4 matrix
+        return np.asarray(x.as_matrix())
+    if kind == "dq":  # q and -q are one motion: the largest |q_r| component made > 0
+        x = np.asarray(x, dtype=float)
+        big = np.argmax(np.abs(x[..., :4]), axis=-1)[..., None]
+        return x * np.sign(np.take_along_axis(x, big, axis=-1))
     if kind == "align":
         if isinstance(x, list):
             return np.stack([np.asarray(r.as_matrix()) for r, _ in x])
