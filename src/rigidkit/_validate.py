@@ -28,7 +28,14 @@ import numpy as np
 
 from ._engine import dask_backend
 from ._engine.namespace import is_float32, is_half, is_numpy, is_torch, namespace_of
-from .errors import NonFiniteError, NotARotationError, ShapeError, SingularMatrixError
+from .errors import (
+    NonFiniteError,
+    NotARotationError,
+    ShapeError,
+    SingularMatrixError,
+    shape_error,
+)
+from .errors import shape_text as shape_text  # re-exported: callers import checks from here
 
 # -- when values can be checked: concreteness and the validation switch ---------------
 
@@ -128,7 +135,11 @@ def _deferred(x) -> bool:
 
 
 def to_numpy(a):
-    """A NumPy view (or copy) of an array of any namespace, for error messages only."""
+    """A NumPy view (or copy) of an array of any namespace, off the graph and the device.
+
+    For checks and error messages, and for host-side bookkeeping that must not
+    carry gradients (the step weights of the kinematics integrators).
+    """
     if isinstance(a, np.ndarray):
         return a
     if hasattr(a, "detach"):  # torch: off the graph and the device first
@@ -227,16 +238,6 @@ def raise_unless(ok, error, message) -> None:
 
 
 # -- shapes and values -------------------------------------------------------------------
-
-
-def shape_text(trail: tuple) -> str:
-    """``"(..., 3, 3)"`` for the trailing shape ``(3, 3)``."""
-    return "(..., " + ", ".join(map(str, trail)) + ")" if trail else "(...)"
-
-
-def shape_error(what: str, shape: tuple, trail: tuple) -> ShapeError:
-    """The one message of a wrong trailing shape: what, the expected and the actual."""
-    return ShapeError(f"{what}: expected shape {shape_text(trail)}, got {tuple(shape)}")
 
 
 def as_array(x, trail: tuple, what: str):

@@ -77,6 +77,20 @@ class ShapeError(RigidkitError):
     """An array has the wrong trailing shape."""
 
 
+def shape_text(trail: tuple) -> str:
+    """``"(..., 3, 3)"`` for the trailing shape ``(3, 3)``."""
+    return "(..., " + ", ".join(map(str, trail)) + ")" if trail else "(...)"
+
+
+def shape_error(what: str, shape: tuple, trail: tuple) -> ShapeError:
+    """The one message of a wrong trailing shape: what, the expected and the actual.
+
+    Raised by the validation (:mod:`rigidkit._validate`) and by every kernel's
+    own shape check (:mod:`rigidkit._engine.kernel`) alike.
+    """
+    return ShapeError(f"{what}: expected shape {shape_text(trail)}, got {tuple(shape)}")
+
+
 class EulerSequenceError(RigidkitError):
     """An Euler sequence string is not one of the 24 accepted forms."""
 

@@ -449,12 +449,9 @@ class Kernel(_Rebindable):
             shape = tuple(a.shape)
             nt = len(trail)
             if shape[len(shape) - nt :] != trail or len(shape) < nt:
-                from ..errors import ShapeError
+                from ..errors import shape_error
 
-                want = "(..., " + ", ".join(map(str, trail)) + ")" if trail else "(...)"
-                raise ShapeError(
-                    f"{self.name}: argument {k} has shape {shape}, expected {want}"
-                )
+                raise shape_error(f"{self.name}: argument {k}", shape, trail)
             shapes.append(shape[: len(shape) - nt])
         if all(s == shapes[0] for s in shapes):  # the common case; skips ~3 us
             return shapes[0] if shapes else ()
