@@ -4,18 +4,8 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
-from ..._validate import batch_index, where_text
+from ..._validate import batch_index, to_numpy, where_text
 from ...errors import GimbalLockError
-
-
-def _host(a):
-    if isinstance(a, np.ndarray):
-        return a
-    if hasattr(a, "detach"):
-        return a.detach().cpu().numpy()
-    return np.asarray(a)
 
 
 def check_lock(lock_sine, tol: float, seq, fn: str) -> None:
@@ -27,7 +17,7 @@ def check_lock(lock_sine, tol: float, seq, fn: str) -> None:
     is skipped and the rates come out large but finite.
     """
     try:
-        d = _host(lock_sine)
+        d = to_numpy(lock_sine)
     except Exception:  # a tracer: no concrete value to check
         return
     limit = math.sin(min(tol, math.pi / 2))

@@ -18,15 +18,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..._engine.namespace import device_of, is_numpy, namespace_of
+from ..._validate import to_numpy
 from ...errors import DegenerateInputError
-
-
-def _host(a):
-    if isinstance(a, np.ndarray):
-        return a
-    if hasattr(a, "detach"):
-        return a.detach().cpu().numpy()
-    return np.asarray(a)
 
 
 def _node_offsets(d, m: int):
@@ -75,7 +68,7 @@ def rates_at_step_points(rate, h, *, order: int):
             f"the {'midpoint' if m == 2 else 'rk4'} method needs at least {m} samples "
             f"to interpolate the rate, got {n} (use method='exact')"
         )
-    hh = _host(h).astype(np.float64)
+    hh = to_numpy(h).astype(np.float64)
     xp = namespace_of(rate)
     numpy = is_numpy(xp)
 
