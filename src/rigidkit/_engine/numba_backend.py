@@ -276,10 +276,11 @@ _THREAD = None
 
 
 class _Job:
-    __slots__ = ("kernel", "bcast", "dtype", "ints", "done", "loop", "error")
+    __slots__ = ("kernel", "bcast", "dtype", "ints", "build", "done", "loop", "error")
 
-    def __init__(self, kernel, bcast, dtype, ints):
+    def __init__(self, kernel, bcast, dtype, ints, build=None):
         self.kernel, self.bcast, self.dtype, self.ints = kernel, bcast, dtype, ints
+        self.build = build
         self.done = threading.Event()
         self.loop = None
         self.error = None
@@ -290,15 +291,35 @@ def request(kernel, bcast, dtype, ints=()) -> _Job:
 
     When it is ready the thread calls ``kernel._loop_ready(bcast, dtype, ints, loop)``.
     """
-    global _JOBS, _THREAD
     key = (id(kernel), bcast, dtype.char, ints)
     job = _PENDING.get(key)
     if job is not None:
         return job
+    return _submit(key, lambda: _Job(kernel, bcast, dtype, ints))
+
+
+def request_build(key, build) -> _Job:
+    """Queue ``build()``, a compile that is not a kernel's loop, for the background
+    thread (once per ``key``); its result becomes ``job.loop`` when ``job.done``.
+
+    For compiled code generated outside the engine (the integration scan of
+    :mod:`rigidkit.applications.kinematics._scan`), under the same policy as the
+    loops: numba is imported and the code compiled off the caller's thread, and
+    :func:`drain` waits for it.
+    """
+    key = ("build", key)
+    job = _PENDING.get(key)
+    if job is not None:
+        return job
+    return _submit(key, lambda: _Job(None, None, None, None, build))
+
+
+def _submit(key, make) -> _Job:
+    global _JOBS, _THREAD
     with _LOCK:
         job = _PENDING.get(key)
         if job is None:
-            job = _PENDING[key] = _Job(kernel, bcast, dtype, ints)
+            job = _PENDING[key] = make()
             if _JOBS is None:
                 import queue
 
@@ -350,8 +371,11 @@ def _work():
         try:
             if error is not None:
                 raise error
-            job.loop = compile_loop(job.kernel, job.bcast, job.dtype, job.ints)
-            job.kernel._loop_ready(job.bcast, job.dtype, job.ints, job.loop)
+            if job.build is not None:
+                job.loop = job.build()
+            else:
+                job.loop = compile_loop(job.kernel, job.bcast, job.dtype, job.ints)
+                job.kernel._loop_ready(job.bcast, job.dtype, job.ints, job.loop)
         except BaseException as exc:  # noqa: BLE001 - handed to whoever waits
             job.error = exc
         job.done.set()

@@ -5,7 +5,8 @@ For ``R' = R hat(w(t))`` (body) or ``R' = hat(w(t)) R`` (world) the step from
 R_k`` (world), and ``theta_k`` depends on the rate only, not on ``R_k``: the
 increments of every step are computed at once (batched, fused), and only their
 product is sequential (see :mod:`rigidkit.applications.kinematics.integration`).
-The same holds for SE(3) and twists ``(v, w)``.
+The same holds for SE(3) and twists ``(v, w)``, and for the plane (the kernels
+of SO(2) and SE(2) steps are in :mod:`.kinematics_planar`).
 
 ``theta`` per method:
 
@@ -33,7 +34,7 @@ from .._engine import helper, kernel
 from .quaternion import quat_multiply
 from .rotvec import quat_entries_from_rotvec
 from .se3 import bracket, pose_compose, pose_from_twist
-from .vector import hat_poly_apply
+from .vector import hat_poly_apply, renormalize4
 
 
 @helper
@@ -57,19 +58,6 @@ def se3_dexp_inv(s, u0, u1, u2, u3, u4, u5, a0, a1, a2, a3, a4, a5):
         a4 + k * b[4] + g * c[4],
         a5 + k * b[5] + g * c[5],
     )
-
-
-@helper
-def renormalize_near_unit(w, x, y, z):
-    """``q (3 - |q|^2) / 2``: one Newton step of ``q / |q|`` for ``|q|`` near 1.
-
-    The product of two unit quaternions has ``|q|^2 = 1 + e``, ``|e|`` a few eps;
-    the step leaves ``|q|^2 = 1 + O(e^2)``, unit to rounding, with no square root
-    or division. Applied at every step the norm error does not accumulate (it
-    would grow linearly without it).
-    """
-    k = 1.5 - 0.5 * (w * w + x * x + y * y + z * z)
-    return (k * w, k * x, k * y, k * z)
 
 
 @kernel(inputs=[(3,), ()], outputs=[(4,)])
@@ -149,15 +137,16 @@ def so3_chain(body, w1, x1, y1, z1, w2, x2, y2, z2):
     ``a`` is the earlier factor (the orientation so far), ``b`` the later one (a
     step); the composition is associative, so the same link serves a sequential
     scan and a parallel prefix product. Both factors are unit quaternions (to
-    rounding), so :func:`renormalize_near_unit` keeps ``|q| = 1`` to rounding over
-    any number of steps.
+    rounding), so :func:`~rigidkit.kernels.vector.renormalize4` (one Newton step
+    towards ``|q| = 1``) keeps them unit to rounding over any number of steps: the
+    norm error does not accumulate (it would grow linearly without it).
     """
     b = body == 1
     p = quat_multiply(
         where(b, w1, w2), where(b, x1, x2), where(b, y1, y2), where(b, z1, z2),
         where(b, w2, w1), where(b, x2, x1), where(b, y2, y1), where(b, z2, z1),
     )  # fmt: skip
-    return renormalize_near_unit(p[0], p[1], p[2], p[3])
+    return renormalize4(p[0], p[1], p[2], p[3])
 
 
 @kernel(inputs=[(7,), (7,)], outputs=[(7,)], params=("body",))
@@ -171,5 +160,5 @@ def se3_chain(body, w1, x1, y1, z1, a1, b1, c1, w2, x2, y2, z2, a2, b2, c2):
         where(b, w2, w1), where(b, x2, x1), where(b, y2, y1), where(b, z2, z1),
         where(b, a2, a1), where(b, b2, b1), where(b, c2, c1),
     )  # fmt: skip
-    u = renormalize_near_unit(p[0], p[1], p[2], p[3])
+    u = renormalize4(p[0], p[1], p[2], p[3])
     return (u[0], u[1], u[2], u[3], p[4], p[5], p[6])

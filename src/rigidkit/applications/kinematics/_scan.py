@@ -2,26 +2,32 @@
 
 ``out[0] = x0``, ``out[k + 1] = chain(out[k], inc[k])`` along the step axis, for a
 ``chain`` kernel of :mod:`rigidkit.kernels.kinematics_integration` (``so3_chain``,
-``se3_chain``: associative, normalising). Two bindings of the same kernel:
+``se3_chain``, ``so2_chain``, ``se2_chain``: associative, normalising). Two
+bindings of the same kernel:
 
 * NumPy with numba: one compiled loop over trajectories and steps, generated from
-  the kernel's own source (as the engine generates its loops) and cached on disk
-  next to the engine's. numba is imported only here, on the first call that is
-  large enough (``COMPILE_MIN`` steps in all); smaller calls never wait for it.
-  Many trajectories are split over the idle cores (threads, ``nogil``).
-* Any other array namespace (torch, JAX, NumPy without numba): a parallel prefix
-  product (Hillis-Steele doubling), ``log2(N)`` rounds of the chain kernel over
-  whole arrays; built from slicing and concatenation only, so it traces under
-  ``jax.jit`` and gradients flow through it. Its rounding grows with ``log N``
-  rather than ``N``.
+  the kernel's own source (as the engine generates its loops), compiled for one
+  signature per dtype and cached on disk next to the engine's. Like the engine's
+  loops it is compiled (or loaded from the cache) by the engine's background
+  thread (:func:`.numba_backend.request_build`), never on the caller's: a call
+  made before it is ready runs the prefix product below. It is asked for by calls
+  of at least ``COMPILE_MIN`` steps in all, before their increments are computed
+  (:func:`prepare`), so that a cached scan is usually loaded by the time they are
+  needed. Many trajectories are split over the idle cores (threads, ``nogil``).
+* Any other array namespace (torch, JAX, NumPy without numba or before the scan is
+  ready): a work-efficient parallel prefix product (Ladner-Fischer / Blelloch):
+  the pairs ``x[2i] x[2i+1]`` are multiplied, their prefix products found
+  recursively, and the even entries completed with one more product: about
+  ``2 N`` chain evaluations over whole arrays in ``log2(N)`` rounds (the earlier
+  Hillis-Steele doubling took ``N log2(N)``, ten times more at 3.6 M steps). Built
+  from slicing, stacking and concatenation only, so it traces under ``jax.jit``
+  and gradients flow through it. Its rounding grows with ``log N`` rather than
+  ``N``.
 """
 
 from __future__ import annotations
 
-import hashlib
 import os
-import sys
-import threading
 
 import numpy as np
 
@@ -29,10 +35,11 @@ from ..._engine import numba_backend as _nb
 from ..._engine.namespace import is_numpy, namespace_of
 from ..._engine.primitives import NUMBA_PRELUDE
 
-#: Fewer steps than this (over all trajectories) take the array path, no compile.
+#: Calls of fewer steps than this (over all trajectories) never ask for the
+#: compiled scan: the prefix product serves them in well under a millisecond more.
 COMPILE_MIN = int(os.environ.get("RIGIDKIT_SCAN_COMPILE_MIN", "20000"))
 
-_LOCK = threading.Lock()
+#: The compiled scans that are ready, by (chain name, width, dtype char).
 _SCANS: dict = {}
 
 
@@ -47,7 +54,6 @@ def _scan_source(chain, width: int) -> str:
     w = range(width)
     state = ", ".join(f"s{c}" for c in w)
     lines = [
-        "@numba.njit(cache=CACHE, nogil=True, error_model='numpy')",
         "def scan(body, x0, inc, out):",
         "    n, steps = inc.shape[0], inc.shape[1]",
         "    for b in range(n):",
@@ -64,67 +70,111 @@ def _scan_source(chain, width: int) -> str:
     return "\n".join(parts)
 
 
-def _compiled(chain, width: int):
-    """The numba scan of ``chain`` (imported from, or written to, the disk cache)."""
-    key = (chain.name, width)
-    scan = _SCANS.get(key)
-    if scan is not None:
-        return scan
+def _build(chain, width: int, dtype):
+    """Compile (or load from the disk cache) the scan of ``chain`` for ``dtype``.
+
+    Runs on the engine's background thread. One explicit signature (``body``
+    int64; ``x0`` (n, W) and ``inc`` (n, N, W) read-only; ``out`` (n, N + 1, W)),
+    so a call never compiles again.
+    """
+    import hashlib
     import importlib.util
+    import sys
     import tempfile
 
     import numba
+    from numba import types
 
     src = _scan_source(chain, width)
     digest = hashlib.sha1((src + numba.__version__).encode()).hexdigest()[:16]
     modname = f"rigidkit_scan_{chain.name}_{digest}"
     folder = _nb._cache_dir()
-    with _LOCK:
-        if key in _SCANS:
-            return _SCANS[key]
+    module = sys.modules.get(modname)
+    if module is None:
+        module = type(sys)(modname)
         if folder is None:
-            namespace = {"CACHE": False}
-            exec(compile(src, f"<rigidkit scan {chain.name}>", "exec"), namespace)
-            scan = namespace["scan"]
+            exec(compile(src, f"<rigidkit scan {chain.name}>", "exec"), module.__dict__)
         else:
+            # numba's disk cache needs the function in a real file.
             path = os.path.join(folder, modname + ".py")
             if not os.path.exists(path):
                 fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
                 with os.fdopen(fd, "w") as fh:
-                    fh.write("CACHE = True\n" + src)
+                    fh.write(src)
                 os.replace(tmp, path)
             spec = importlib.util.spec_from_file_location(modname, path)
             module = importlib.util.module_from_spec(spec)
             spec.loader.exec_module(module)
-            sys.modules[modname] = module
-            scan = module.scan
-        _SCANS[key] = scan
+        sys.modules[modname] = module
+    dt = types.float32 if dtype.itemsize == 4 else types.float64
+    sig = types.void(
+        types.int64,
+        types.Array(dt, 2, "C", readonly=True),
+        types.Array(dt, 3, "C", readonly=True),
+        types.Array(dt, 3, "C"),
+    )
+    scan = numba.njit([sig], cache=folder is not None, nogil=True, error_model="numpy")(
+        module.scan
+    )
+    _SCANS[(chain.name, width, dtype.char)] = scan
     return scan
+
+
+def _request(chain, width: int, dtype):
+    return _nb.request_build(
+        ("scan", chain.name, width, dtype.char), lambda: _build(chain, width, dtype)
+    )
+
+
+def prepare(chain, x0, rate, steps: int) -> None:
+    """Ask for the compiled scan of a coming call (before its increments are made).
+
+    A no-op off NumPy, without numba, or below ``COMPILE_MIN`` steps in all.
+    """
+    if not (isinstance(rate, np.ndarray) and _nb.available()):
+        return
+    batch = np.broadcast_shapes(tuple(x0.shape[:-1]), tuple(rate.shape[:-2]))
+    if int(np.prod(batch, dtype=np.int64)) * steps < COMPILE_MIN:
+        return
+    dtype = np.result_type(x0.dtype, rate.dtype)
+    if dtype.kind == "f" and dtype.itemsize in (4, 8):
+        _request(chain, _width(chain), dtype)
+
+
+def _width(chain) -> int:
+    return chain.outputs[0][0]
+
+
+def wait(chain, dtype) -> None:
+    """Block until the compiled scan of ``chain`` for ``dtype`` is ready (tests)."""
+    job = _request(chain, _width(chain), np.dtype(dtype))
+    job.done.wait()
+    if job.error is not None:
+        raise job.error
 
 
 def running_product(chain, body: int, x0, inc):
     """``(..., N + 1, W)`` running products of ``x0`` (..., W) and ``inc`` (..., N, W).
 
     The batch shapes of ``x0`` and ``inc`` broadcast; ``chain(body, a, b)`` is the
-    link (``a b`` for body frames, ``b a`` for world frames).
+    link (``a b`` for body frames, ``b a`` for world frames). The compiled scan
+    runs when it is ready (never waited for); otherwise the prefix product.
     """
     xp = namespace_of(x0, inc)
     width = inc.shape[-1]
     steps = inc.shape[-2]
     batch = tuple(np.broadcast_shapes(tuple(x0.shape[:-1]), tuple(inc.shape[:-2])))
     n = int(np.prod(batch, dtype=np.int64))
-    if (
-        is_numpy(xp)
-        and isinstance(inc, np.ndarray)
-        and n * steps >= COMPILE_MIN
-        and _nb.available()
-    ):
-        return _numba_product(chain, body, x0, inc, batch, n, steps, width)
-    return _doubling_product(chain, body, x0, inc, batch, xp)
+    if is_numpy(xp) and isinstance(inc, np.ndarray) and n * steps >= COMPILE_MIN:
+        dtype = np.result_type(x0.dtype, inc.dtype)
+        scan = _SCANS.get((chain.name, width, dtype.char))
+        if scan is not None:
+            return _numba_product(scan, body, x0, inc, batch, n, steps, width, dtype)
+        prepare(chain, x0, inc, steps)
+    return _prefix_product(chain, body, x0, inc, batch, xp)
 
 
-def _numba_product(chain, body, x0, inc, batch, n, steps, width):
-    dtype = np.result_type(x0.dtype, inc.dtype)
+def _numba_product(scan, body, x0, inc, batch, n, steps, width, dtype):
     x0 = np.ascontiguousarray(np.broadcast_to(x0, batch + (width,)), dtype).reshape(
         n, width
     )
@@ -132,7 +182,6 @@ def _numba_product(chain, body, x0, inc, batch, n, steps, width):
         n, steps, width
     )
     out = np.empty((n, steps + 1, width), dtype)
-    scan = _compiled(chain, width)
     workers = min(n, _nb._workers()) if n > 1 and n * steps >= 2 * COMPILE_MIN else 1
     if workers < 2:
         scan(body, x0, inc, out)
@@ -148,23 +197,43 @@ def _numba_product(chain, body, x0, inc, batch, n, steps, width):
     return out.reshape(batch + (steps + 1, width))
 
 
-def _doubling_product(chain, body, x0, inc, batch, xp):
-    steps = inc.shape[-2]
+def _prefix_product(chain, body, x0, inc, batch, xp):
     width = inc.shape[-1]
-    if tuple(inc.shape[:-2]) != batch:
-        inc = xp.broadcast_to(inc, batch + (steps, width))
-    prefix = inc
-    shift = 1
-    while shift < steps:
-        # prefix[k] <- prefix[k - shift] * prefix[k]: after the round, prefix[k]
-        # is the product of inc[max(0, k - 2 shift + 1) ... k], in order.
-        later = chain(body, prefix[..., : steps - shift, :], prefix[..., shift:, :])
-        prefix = xp.concat([prefix[..., :shift, :], later], axis=-2)
-        shift *= 2
     if tuple(x0.shape[:-1]) != batch:
         x0 = xp.broadcast_to(x0, batch + (width,))
-    head = x0[..., None, :]
-    if steps == 0:
-        return head
-    rest = chain(body, xp.broadcast_to(head, batch + (steps, width)), prefix)
-    return xp.concat([head, rest], axis=-2)
+    if tuple(inc.shape[:-2]) != batch:
+        inc = xp.broadcast_to(inc, batch + tuple(inc.shape[-2:]))
+    # x0 is the earliest factor: the running products are the prefixes of [x0, inc].
+    seq = xp.concat([x0[..., None, :], inc], axis=-2)
+    # On NumPy the chain runs element-wise (backend="xp"): its own compiled loops
+    # would be background compiles for a path the compiled scan replaces.
+    kw = {"backend": "xp"} if is_numpy(xp) else {}
+    return _prefixes(lambda a, b: chain(body, a, b, **kw), seq, xp)
+
+
+def running_sum(inc):
+    """``(..., N + 1, W)``: 0, ``inc[0]``, ``inc[0] + inc[1]``, ...: the running
+    product of an abelian group written additively (SO(2) angles), by the same
+    prefix scheme (rounding grows with ``log N``, where ``cumsum``'s grows with
+    ``N``)."""
+    xp = namespace_of(inc)
+    seq = xp.concat([0.0 * inc[..., :1, :], inc], axis=-2)
+    return _prefixes(lambda a, b: a + b, seq, xp)
+
+
+def _prefixes(link, x, xp):
+    """Inclusive prefix products of ``x`` (..., n, W) along axis -2, in order."""
+    n = x.shape[-2]
+    if n == 1:
+        return x
+    m = n // 2
+    pairs = link(x[..., 0 : 2 * m : 2, :], x[..., 1 : 2 * m : 2, :])
+    odd = _prefixes(link, pairs, xp)  # odd[i]: the product of x[0 .. 2i + 1]
+    # The even entries: x[0], then odd[i - 1] x[2i].
+    even = xp.concat(
+        [x[..., :1, :], link(odd[..., : (n - 1) // 2, :], x[..., 2::2, :])], axis=-2
+    )
+    lead = tuple(x.shape[:-2])
+    width = x.shape[-1]
+    both = xp.reshape(xp.stack([even[..., :m, :], odd], axis=-2), lead + (2 * m, width))
+    return both if n == 2 * m else xp.concat([both, even[..., m:, :]], axis=-2)

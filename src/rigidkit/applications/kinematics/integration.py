@@ -22,11 +22,15 @@ constant rate gives ``exp(w t)`` with every method.
 The increments of all steps are computed at once (they do not depend on the
 orientation: batched kernels, fused numba loops on NumPy); only their running
 product is sequential: a compiled numba loop on NumPy (3.6 M steps, an hour at
-1 kHz, take well under a second), a parallel prefix product on torch, JAX and
-NumPy without numba (see :mod:`._scan`).
+1 kHz, take well under a second), a parallel prefix product on torch, JAX,
+NumPy without numba, and NumPy calls made before the compiled loop is ready
+(it is compiled in the background, never waited for; see :mod:`._scan`).
+The plane has its own versions in :mod:`.planar`.
 """
 
 from __future__ import annotations
+
+from functools import partial
 
 import numpy as np
 
@@ -36,8 +40,8 @@ from ...errors import ShapeError
 from ...kernels import kinematics_integration as _k
 from ...objects.rotation import Rotation
 from ...objects.transform import Transform
+from . import _scan
 from ._common import body_flag, homogeneous_matrix, rotation_matrix
-from ._scan import running_product
 from ._stencils import rates_at_step_points
 
 __all__ = ["integrate_angular_velocity", "integrate_twist"]
@@ -68,19 +72,37 @@ def _steps(dt, rate, fn):
     return h
 
 
-def _increments(kind, body, method, rate, h):
-    """The per-step group elements (quaternions or poses), shape (..., N, W)."""
-    one, rk4 = (
-        (_k.so3_increment, _k.so3_increment_rk4)
-        if kind == "so3"
-        else (_k.se3_increment, _k.se3_increment_rk4)
-    )
+def _increments(one, rk4, method, rate, h):
+    """The per-step group elements, shape (..., N, W): ``one(rate, h)`` per step
+    (zero-order hold, or midpoint given the midpoint rates), or ``rk4(start, mid,
+    end, h)`` from the rates at three points of each step."""
     if method == "exact":
         return one(rate, h)
     mid, end = rates_at_step_points(rate, h, order=2 if method == "midpoint" else 4)
     if method == "midpoint":
         return one(mid, h)
-    return rk4(body, rate, mid, end, h)
+    return rk4(rate, mid, end, h)
+
+
+def integrate(x0, rate, dt, method, fn, *, width, what, one, rk4, chain=None, body=0):
+    """The trajectory ``(..., N + 1, W)`` from ``x0`` (..., W) and the rate samples.
+
+    Shared by every group (``x0`` in the group's storage: quaternions, poses,
+    complex numbers): validates the rates (``(..., N, width)``), the steps and
+    the method, makes the increments (``one``, ``rk4``: see :func:`_increments`)
+    and chains them with the kernel ``chain`` (:func:`._scan.running_product`).
+    Without ``chain`` (an abelian group written additively, SO(2) angles) the
+    result is ``x0`` and the running sums of the increments, shape (..., N + 1, 1).
+    """
+    _method(method, fn)
+    r = _samples(rate, width, what, fn)
+    h = _steps(dt, r, fn)
+    x0 = _like(x0, r)
+    if chain is None:
+        return x0, _scan.running_sum(_increments(one, rk4, method, r, h))
+    # Asked for before the increments are made: a cached scan loads meanwhile.
+    _scan.prepare(chain, x0, r, r.shape[-2])
+    return _scan.running_product(chain, body, x0, _increments(one, rk4, method, r, h))
 
 
 def _samples(rate, width, what, fn):
@@ -134,14 +156,13 @@ def integrate_angular_velocity(R0, omega, dt, *, frame=None, method="exact"):
     """
     fn = "integrate_angular_velocity"
     body = body_flag(frame, fn)
-    _method(method, fn)
     as_object = isinstance(R0, Rotation)
     q0 = R0.as_quat() if as_object else Rotation.from_matrix(rotation_matrix(R0)).as_quat()
-    w = _samples(omega, 3, "angular velocity", fn)
-    h = _steps(dt, w, fn)
-    q0 = _like(q0, w)
-    dq = _increments("so3", body, method, w, h)
-    q = running_product(_k.so3_chain, body, q0, dq)
+    q = integrate(
+        q0, omega, dt, method, fn, width=3, what="angular velocity",
+        one=_k.so3_increment, rk4=partial(_k.so3_increment_rk4, body),
+        chain=_k.so3_chain, body=body,
+    )  # fmt: skip
     traj = Rotation._wrap(q)
     return traj if as_object else traj.as_matrix()
 
@@ -182,17 +203,16 @@ def integrate_twist(T0, twist, dt, *, frame=None, method="exact"):
     """
     fn = "integrate_twist"
     body = body_flag(frame, fn)
-    _method(method, fn)
     as_object = isinstance(T0, Transform)
     if as_object:
         p0 = T0._pose
     else:
         p0 = Transform.from_matrix(homogeneous_matrix(T0))._pose
-    V = _samples(twist, 6, "twist", fn)
-    h = _steps(dt, V, fn)
-    p0 = _like(p0, V)
-    dp = _increments("se3", body, method, V, h)
-    p = running_product(_k.se3_chain, body, p0, dp)
+    p = integrate(
+        p0, twist, dt, method, fn, width=6, what="twist",
+        one=_k.se3_increment, rk4=partial(_k.se3_increment_rk4, body),
+        chain=_k.se3_chain, body=body,
+    )  # fmt: skip
     traj = Transform._wrap(p)
     return traj if as_object else traj.as_matrix()
 

@@ -5,7 +5,9 @@ notes' ``e^{J omega t}``: the additive property ``F(t) F(s) = F(t + s)`` makes
 ``R = exp(omega J t)`` with ``omega J = R'(0)``), turns at ``omega`` with
 ``R' = omega J R = R omega J``: world and body angular velocity are one number
 (shape (..., 1), like the so(2) tangent vectors). Planar twists are
-``(vx, vy, omega)`` with ``T' = hat(V) T`` (world) or ``T hat(V)`` (body).
+``(vx, vy, omega)`` with ``T' = hat(V) T`` (world) or ``T hat(V)`` (body),
+``V_world = Ad_T V_body``. Sampled rates integrate into trajectories as in 3D
+(:func:`integrate_angular_velocity`, :func:`integrate_twist`).
 
 >>> import numpy as np
 >>> R = np.array([[0.0, -1.0], [1.0, 0.0]])          # theta = pi/2
@@ -16,18 +18,28 @@ array([3.])
 
 from __future__ import annotations
 
+from functools import partial
+
 from ...functional import se2 as _se2
 from ...functional import so2 as _so2
 from ...kernels import kinematics_planar as _k
+from ...kernels import so2 as _kso2
+from ...objects.rotation2d import Rotation2D
+from ...objects.transform2d import Transform2D
 from ._common import body_flag, vector
+from .integration import integrate
 
 __all__ = [
     "angular_velocity",
     "rotation_derivative",
     "twist_from_derivative",
     "transform_derivative",
+    "twist_to_world",
+    "twist_to_body",
     "point_velocity",
     "point_acceleration",
+    "integrate_angular_velocity",
+    "integrate_twist",
 ]
 
 
@@ -131,6 +143,63 @@ def transform_derivative(T, twist, *, frame=None):
     )
 
 
+def twist_to_world(T, twist_body):
+    """``V_world = Ad_T V_body = (R v + omega (ty, -tx), omega)``, planar twists.
+
+    Parameters
+    ----------
+    T : Transform2D or array_like, shape (..., 3, 3)
+        ``W_T_B``.
+    twist_body : array_like, shape (..., 3)
+        ``(vx, vy, omega)`` in the body frame.
+
+    Returns
+    -------
+    array, shape (..., 3)
+
+    See Also
+    --------
+    twist_to_body : the inverse.
+
+    Examples
+    --------
+    Turning in place about the body origin, one unit along x: the world twist's
+    ``v`` is the velocity of the world point at the origin.
+
+    >>> import numpy as np
+    >>> T = np.eye(3); T[0, 2] = 1.0
+    >>> twist_to_world(T, [0.0, 0.0, 1.0])
+    array([ 0., -1.,  1.])
+    """
+    return _k.twist_change_frame_2d(
+        0, _transform(T), vector(twist_body, (3,), "body twist")
+    )
+
+
+def twist_to_body(T, twist_world):
+    """``V_body = Ad_T^-1 V_world = (R^T (v - omega (ty, -tx)), omega)``.
+
+    Parameters
+    ----------
+    T : Transform2D or array_like, shape (..., 3, 3)
+    twist_world : array_like, shape (..., 3)
+
+    Returns
+    -------
+    array, shape (..., 3)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> T = np.eye(3); T[0, 2] = 1.0
+    >>> twist_to_body(T, [0.0, -1.0, 1.0]) + 0.0
+    array([0., 0., 1.])
+    """
+    return _k.twist_change_frame_2d(
+        1, _transform(T), vector(twist_world, (3,), "world twist")
+    )
+
+
 def point_velocity(omega, r, v_origin=(0.0, 0.0)):
     """``v = v_O + omega J r`` of the point at ``r`` from a body point ``O``.
 
@@ -185,3 +254,104 @@ def point_acceleration(
         vector(v_rel, (2,), "v_rel"),
         vector(a_rel, (2,), "a_rel"),
     )
+
+
+def integrate_angular_velocity(R0, omega, dt, *, frame=None, method="exact"):
+    """Planar orientations of a body turning at the sampled rates ``omega``.
+
+    SO(2) is commutative, so ``R_N = R_0 exp(J theta_N)`` with ``theta_N`` the
+    integral of the rate: "exact" (zero-order hold) sums ``omega_k dt_k``,
+    "midpoint" sums the midpoint rates (linear interpolation, 2nd order), and
+    "rk4" applies Simpson's rule on the cubic through the nearest samples (RKMK4,
+    whose brackets vanish in the plane: 4th order). Sampling and step times as in
+    :func:`rigidkit.kinematics.integrate_angular_velocity`. The angles are
+    summed by a pairwise scheme (rounding grows with ``log N``).
+
+    Parameters
+    ----------
+    R0 : Rotation2D or array_like, shape (..., 2, 2)
+        Initial orientation ``W_R_B``.
+    omega : array_like, shape (..., N, 1)
+        Angular velocity samples (rad per unit time, counter-clockwise), one
+        1-vector per step like the so(2) tangent vectors; a 1-D log ``w`` of N
+        samples is ``w[:, None]``. The batch shape broadcasts with ``R0``'s.
+    dt : float or array_like, shape (N,) or (..., N)
+        Step durations.
+    frame : {"world", "body"}
+        Required for uniformity with 3D (the two agree in the plane).
+    method : {"exact", "midpoint", "rk4"}
+        "midpoint" needs N >= 2 samples, "rk4" N >= 4.
+
+    Returns
+    -------
+    Rotation2D of shape (..., N + 1), or matrices (..., N + 1, 2, 2) when ``R0``
+    is an array. Element 0 is ``R0``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import rigidkit as rk
+    >>> w = np.full((100, 1), np.pi / 2)                 # a quarter turn in 1 s
+    >>> traj = integrate_angular_velocity(rk.Rotation2D.identity(), w, 0.01,
+    ...                                   frame="body")
+    >>> traj.shape, round(float(traj[-1].angle), 12)
+    ((101,), 1.570796326795)
+    """
+    fn = "planar.integrate_angular_velocity"
+    body_flag(frame, fn)
+    as_object = isinstance(R0, Rotation2D)
+    z0 = (R0 if as_object else Rotation2D.from_matrix(_rotation(R0)))._data
+    z0, theta = integrate(
+        z0, omega, dt, method, fn, width=1, what="angular velocity",
+        one=_k.so2_increment, rk4=_k.so2_increment_rk4,
+    )  # fmt: skip
+    z = _kso2.complex_multiply(z0[..., None, :], _kso2.complex_from_angle(theta))
+    traj = Rotation2D._wrap(z)
+    return traj if as_object else traj.as_matrix()
+
+
+def integrate_twist(T0, twist, dt, *, frame=None, method="exact"):
+    """Planar poses of a body moving with the sampled twists ``(vx, vy, omega)``.
+
+    Body frame (odometry: ``v`` the velocity of the body origin in its own axes):
+    ``T' = T hat(V)``; world frame: ``T' = hat(V) T``. Each step is ``exp`` of
+    se(2), chained in order; methods and sampling as in
+    :func:`rigidkit.kinematics.integrate_twist` (zero-order hold, 2nd and 4th
+    order, RKMK4 with the bracket of se(2)).
+
+    Parameters
+    ----------
+    T0 : Transform2D or array_like, shape (..., 3, 3)
+        Initial pose ``W_T_B``.
+    twist : array_like, shape (..., N, 3)
+    dt : float or array_like, shape (N,) or (..., N)
+    frame : {"world", "body"}
+    method : {"exact", "midpoint", "rk4"}
+
+    Returns
+    -------
+    Transform2D of shape (..., N + 1), or matrices (..., N + 1, 3, 3) when ``T0``
+    is an array.
+
+    Examples
+    --------
+    A unicycle driving a half circle of radius 2: forward at 2, turning at 1 rad/s.
+
+    >>> import numpy as np
+    >>> import rigidkit as rk
+    >>> V = np.tile([2.0, 0.0, 1.0], (100, 1))
+    >>> traj = integrate_twist(rk.Transform2D.identity(), V, np.pi / 100, frame="body")
+    >>> np.round(traj[-1].translation, 12) + 0.0
+    array([0., 4.])
+    """
+    fn = "planar.integrate_twist"
+    body = body_flag(frame, fn)
+    as_object = isinstance(T0, Transform2D)
+    p0 = (T0 if as_object else Transform2D.from_matrix(_transform(T0)))._data
+    p = integrate(
+        p0, twist, dt, method, fn, width=3, what="planar twist",
+        one=_k.se2_increment, rk4=partial(_k.se2_increment_rk4, body),
+        chain=_k.se2_chain, body=body,
+    )  # fmt: skip
+    traj = Transform2D._wrap(p)
+    return traj if as_object else traj.as_matrix()
