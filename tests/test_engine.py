@@ -241,6 +241,10 @@ PARAM_SAMPLERS = {
         _euler_params(rng, True),
         [_quats(rng, n, span)],
     ),
+    "pose_formats.pose_distance": lambda rng, n, span: (
+        (2.0, 0.5),  # rotation_weight, translation_weight
+        [*_pose_pair(rng, n)],
+    ),
 }
 
 
