@@ -15,6 +15,7 @@ import numpy as np
 from .._validate import as_array, to_numpy
 from ..functional import averaging as _avg
 from ..functional import conversions as _conv
+from ..functional import davenport as _dav
 from ..functional import euler
 from ..functional import interpolation as _interp
 from ._batch import BatchedArray, batch_shape
@@ -131,10 +132,45 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
         >>> R = Rotation.from_euler("ZYX", [90.0, 0.0, 0.0], degrees=True)
         >>> np.round(R.as_rotvec(), 12) + 0.0
         array([0.        , 0.        , 1.57079633])
-        >>> R.approx_equal(Rotation.from_euler("z", 90.0, degrees=True))
+        >>> bool(R.approx_equal(Rotation.from_euler("z", 90.0, degrees=True)))
         True
         """
         return cls._wrap(euler.quat_from_euler(seq, angles, degrees=degrees))
+
+    @classmethod
+    def from_davenport(cls, axes, order, angles, *, degrees=False):
+        """From Davenport angles: turns about 1 to 3 given axes (scipy's semantics).
+
+        ``order="intrinsic"`` (``"i"``, body axes): ``R = R_n1(t1) R_n2(t2)
+        R_n3(t3)``; ``"extrinsic"`` (``"e"``, world axes): ``R = R_n3(t3) R_n2(t2)
+        R_n1(t1)``. ``axes`` (3,) or (..., n, 3), any nonzero length, consecutive
+        ones orthogonal (``n1`` and ``n3`` may make any angle); ``angles`` (..., n),
+        a scalar for one axis. See
+        :func:`rigidkit.functional.davenport.quat_from_davenport`.
+
+        >>> ez, ey, ex = [0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]
+        >>> angles = [30.0, 20.0, 10.0]
+        >>> R = Rotation.from_davenport([ez, ey, ex], "intrinsic", angles, degrees=True)
+        >>> bool(R.approx_equal(Rotation.from_euler("ZYX", angles, degrees=True)))
+        True
+        """
+        return cls._wrap(_dav.quat_from_davenport(axes, order, angles, degrees=degrees))
+
+    def as_davenport(self, axes, order, *, degrees=False):
+        """Davenport angles about three axes (..., 3, 3), shape (..., 3).
+
+        Conventions and ranges as :meth:`from_davenport` and
+        :func:`rigidkit.functional.davenport.davenport_from_quat` (scipy's): the
+        middle angle lies in an interval of length pi that starts at the angle
+        between the first and last axis; at gimbal lock a
+        :class:`~rigidkit.GimbalLockWarning` and the third angle 0.
+
+        >>> axes = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 1.0]]
+        >>> R = Rotation.from_davenport(axes, "e", [0.4, -0.3, 0.2])
+        >>> np.round(R.as_davenport(axes, "e"), 12) + 0.0
+        array([ 0.4, -0.3,  0.2])
+        """
+        return _dav.davenport_from_quat_unchecked(axes, order, self._quat, degrees=degrees)
 
     @classmethod
     def random(cls, shape=(), rng=None, *, dtype=None):
