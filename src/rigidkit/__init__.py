@@ -7,7 +7,7 @@ Euler UPPER = intrinsic, lower = extrinsic; twists ``(v, omega)``; radians unles
 """
 
 from ._validate import set_validation
-from .errors import (
+from .errors import (  # noqa: F401  (exported below as listed in errors.__all__)
     ConvergenceWarning,
     DegenerateInputError,
     EulerSequenceError,
@@ -26,6 +26,7 @@ from .errors import (
     SingularMatrixError,
     ZeroNormError,
 )
+from .errors import __all__ as _error_names
 from .functional import conversions, se3, so3
 from .objects.rotation import Rotation
 from .objects.transform import Transform
@@ -149,23 +150,7 @@ __all__ = [
     # the validation switch (docs/architecture.md, "Validation policy")
     "set_validation",
     # errors and warnings
-    "RigidkitError",
-    "NotARotationError",
-    "NotARigidTransformError",
-    "NotASimilarityError",
-    "NotAffineError",
-    "SingularMatrixError",
-    "PointAtInfinityError",
-    "NonFiniteError",
-    "ZeroNormError",
-    "ShapeError",
-    "EulerSequenceError",
-    "DegenerateInputError",
-    "OutOfRangeError",
-    "GimbalLockError",
-    "FrameError",
-    "GimbalLockWarning",
-    "ConvergenceWarning",
+    *_error_names,
 ]
 
 

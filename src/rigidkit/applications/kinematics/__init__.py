@@ -40,67 +40,25 @@ True
 """
 
 from . import planar
-from .euler_rates import (
-    angular_acceleration_from_euler_rates,
-    angular_velocity_from_euler_rates,
-    euler_accelerations,
-    euler_rate_matrix,
-    euler_rate_matrix_derivative,
-    euler_rate_matrix_inverse,
-    euler_rates,
-)
-from .integration import integrate_angular_velocity, integrate_twist
-from .rotation import (
-    angular_acceleration,
-    angular_velocity,
-    angular_velocity_from_quaternion_derivative,
-    quaternion_derivative,
-    quaternion_second_derivative,
-    rotation_derivative,
-    rotation_second_derivative,
-)
-from .samples import angular_velocity_from_samples, twist_from_samples
-from .twist import (
-    point_acceleration,
-    point_velocity,
-    screw_from_twist,
-    spatial_acceleration_matrix,
-    transform_derivative,
-    transform_second_derivative,
-    twist_from_derivative,
-    twist_from_screw,
-    twist_to_body,
-    twist_to_world,
-)
+
+# Each module lists its public names once, in its ``__all__``; the package exports
+# them all (a star import takes exactly a module's ``__all__``).
+from .euler_rates import *  # noqa: F403
+from .euler_rates import __all__ as _euler_rates_names
+from .integration import *  # noqa: F403
+from .integration import __all__ as _integration_names
+from .rotation import *  # noqa: F403
+from .rotation import __all__ as _rotation_names
+from .samples import *  # noqa: F403
+from .samples import __all__ as _samples_names
+from .twist import *  # noqa: F403
+from .twist import __all__ as _twist_names
 
 __all__ = [
-    "angular_velocity",
-    "rotation_derivative",
-    "angular_acceleration",
-    "rotation_second_derivative",
-    "euler_rate_matrix",
-    "euler_rate_matrix_inverse",
-    "euler_rate_matrix_derivative",
-    "angular_velocity_from_euler_rates",
-    "euler_rates",
-    "angular_acceleration_from_euler_rates",
-    "euler_accelerations",
-    "quaternion_derivative",
-    "quaternion_second_derivative",
-    "angular_velocity_from_quaternion_derivative",
-    "integrate_angular_velocity",
-    "integrate_twist",
-    "twist_from_derivative",
-    "transform_derivative",
-    "transform_second_derivative",
-    "spatial_acceleration_matrix",
-    "twist_to_world",
-    "twist_to_body",
-    "point_velocity",
-    "point_acceleration",
-    "screw_from_twist",
-    "twist_from_screw",
-    "angular_velocity_from_samples",
-    "twist_from_samples",
+    *_rotation_names,
+    *_euler_rates_names,
+    *_integration_names,
+    *_twist_names,
+    *_samples_names,
     "planar",
 ]
