@@ -305,3 +305,105 @@ def test_apply_inverse_matches_scipy(rng):
     assert got is out
     np.testing.assert_allclose(out, r[2].apply(v, inverse=True), atol=1e-15)
     np.testing.assert_allclose(R.apply(R.apply(v), inverse=True), v, atol=1e-15)
+
+
+# -- symmetry groups and reduce ------------------------------------------------------------
+GROUPS = ["I", "O", "T", "D1", "D2", "D3", "D6", "C1", "C2", "C5"]
+
+
+@pytest.mark.parametrize("group", GROUPS)
+@pytest.mark.parametrize("axis", ["X", "y", "Z"])
+def test_create_group_matches_scipy(group, axis):
+    """The same set of rotations as scipy's (up to order and sign), and a group:
+    closed under composition and inverse."""
+    G = rk.Rotation.create_group(group, axis)
+    want = sci_quat(SciRotation.create_group(group, axis))
+    got = G.as_quat()
+    assert got.shape == want.shape
+    dots = np.abs(got @ want.T)
+    assert np.all(np.abs(dots.max(axis=1) - 1.0) <= 1e-14)  # each of ours in scipy's
+    assert np.all(np.abs(dots.max(axis=0) - 1.0) <= 1e-14)  # and each of scipy's in ours
+    assert np.all(np.abs(np.abs(got @ got.T) - 1.0).min(axis=1) <= 1e-14)
+    assert np.all(np.sort(np.abs(got @ got.T) > 1 - 1e-12, axis=1).sum(axis=1) == 1)
+    products = (G[:, None] @ G[None, :]).as_quat().reshape(-1, 4)
+    assert np.all(np.abs(np.abs(products @ got.T).max(axis=1) - 1.0) <= 1e-13)
+    inverses = G.inv().as_quat()
+    assert np.all(np.abs(np.abs(inverses @ got.T).max(axis=1) - 1.0) <= 1e-14)
+
+
+def test_create_group_bad_input():
+    for bad in ("A", "C0", "D", "Cx", "I2", 3):
+        with pytest.raises(rk.RigidkitError):
+            rk.Rotation.create_group(bad)
+    with pytest.raises(rk.RigidkitError):
+        rk.Rotation.create_group("C3", axis="W")
+    assert isinstance(rk.RigidkitError("x"), ValueError)
+    assert rk.Rotation.create_group("T", dtype=np.float32).dtype == np.float32
+
+
+@pytest.mark.parametrize(
+    "left, right", [("I", None), (None, "O"), ("T", "D3"), ("C4", "I"), ("O", "O")]
+)
+def test_reduce_matches_scipy(rng, left, right):
+    p = SciRotation.random(40, rng)
+    L = None if left is None else rk.Rotation.create_group(left)
+    R = None if right is None else rk.Rotation.create_group(right, "X")
+    sL = None if left is None else SciRotation.create_group(left)
+    sR = None if right is None else SciRotation.create_group(right, "X")
+    P = rk.Rotation.from_quat(sci_quat(p))
+    reduced, li, ri = P.reduce(L, R, return_indices=True)
+    want = p.reduce(sL, sR)
+    np.testing.assert_allclose(reduced.magnitude(), want.magnitude(), atol=1e-14)
+    if left is None or right is None:
+        # With one group the smallest l p (or p r) is unique for random p: scipy's.
+        # With both, h l p r h^-1 has the same angle wherever h is in both groups.
+        assert_same_rotations(reduced.as_quat(), sci_quat(want), tol=1e-14)
+    # The indices name the pair that gives it.
+    rebuilt = P
+    if L is not None:
+        assert li.shape == (40,)
+        rebuilt = L[li] @ rebuilt
+    else:
+        assert li is None
+    if R is not None:
+        rebuilt = rebuilt @ R[ri]
+    else:
+        assert ri is None
+    assert np.all(rebuilt.approx_equal(reduced, atol=1e-14))
+    # And no other pair is smaller (brute force over both groups).
+    Ls = rk.Rotation.identity((1,)) if L is None else L
+    Rs = rk.Rotation.identity((1,)) if R is None else R
+    every = Ls[:, None, None] @ P[None, :, None] @ Rs[None, None, :]
+    smallest = every.magnitude().min(axis=(0, 2))
+    np.testing.assert_allclose(reduced.magnitude(), smallest, atol=1e-14)
+
+
+def test_reduce_single_identity_and_backends(rng, torch):
+    G = rk.Rotation.create_group("O")
+    p = rk.Rotation.random((), rng)
+    red, li, ri = p.reduce(left=G, return_indices=True)
+    assert red.shape == () and li.shape == () and ri is None
+    assert p.reduce() is p
+    want = SciRotation.from_quat(p.as_quat(), scalar_first=True).reduce(
+        SciRotation.create_group("O")
+    )
+    assert_same_rotations(red.as_quat(), sci_quat(want), tol=1e-14)
+    # torch in, torch out; gradients flow through the selected composition.
+    q = torch.tensor(p.as_quat().copy(), requires_grad=True)
+    red_t = rk.Rotation.from_quat(q).reduce(G)
+    assert isinstance(red_t.as_quat(), torch.Tensor)
+    assert_same_rotations(red_t.as_quat().detach().numpy(), red.as_quat())
+    red_t.as_quat()[0].backward()
+    assert torch.isfinite(q.grad).all()
+
+
+def test_reduce_under_jax_jit(rng, jax):
+    G = rk.Rotation.create_group("T")
+    p = rk.Rotation.random(5, rng)
+
+    @jax.jit
+    def reduced(q):
+        return rk.Rotation.from_quat(q).reduce(G, G).as_quat()
+
+    got = np.asarray(reduced(jax.numpy.asarray(p.as_quat())))
+    assert_same_rotations(got, p.reduce(G, G).as_quat(), tol=1e-14)

@@ -86,7 +86,7 @@ def _unit_axes(axes, *, exactly3, like=None):
     ``like``: an array whose namespace, floating dtype and device the axes take
     (the quaternions or angles they combine with).
     """
-    axes = _axes_like(axes, like)
+    axes = asarray_like(axes, like)
     a = finite_array(axes, (3,), "Davenport axes")
     if a.ndim == 1:
         a = a[None]
@@ -118,7 +118,7 @@ def _unit_axes(axes, *, exactly3, like=None):
     return unit, n, bad
 
 
-def _axes_like(axes, like):
+def asarray_like(axes, like):
     """``axes`` in the namespace, floating dtype and device of ``like`` (if any)."""
     dtype = getattr(like, "dtype", None)
     if dtype is None:

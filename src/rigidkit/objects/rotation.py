@@ -18,6 +18,7 @@ from ..functional import conversions as _conv
 from ..functional import davenport as _dav
 from ..functional import euler
 from ..functional import interpolation as _interp
+from ..functional import symmetry as _sym
 from ._batch import BatchedArray, batch_shape
 from ._frozen import frozen
 from .group import LieGroup
@@ -171,6 +172,49 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
         array([ 0.4, -0.3,  0.2])
         """
         return _dav.davenport_from_quat_unchecked(axes, order, self._quat, degrees=degrees)
+
+    @classmethod
+    def create_group(cls, group, axis="Z", *, dtype=None):
+        """The elements of a finite rotation group, shape (n,) (scipy's ``create_group``).
+
+        ``group``: ``"I"`` (icosahedral, 60), ``"O"`` (octahedral, 24), ``"T"``
+        (tetrahedral, 12), ``"Dn"`` (dihedral, 2n) or ``"Cn"`` (cyclic, n) about
+        ``axis`` (``"X"``, ``"Y"``, ``"Z"``). Built NumPy-side (float64 unless
+        ``dtype``); see :func:`rigidkit.functional.symmetry.quat_group`.
+
+        >>> len(Rotation.create_group("O")), Rotation.create_group("D2", "X").shape
+        (24, (4,))
+        """
+        q = _sym.quat_group(group, axis, dtype=np.float64 if dtype is None else dtype)
+        return cls._wrap(q)
+
+    def reduce(self, left=None, right=None, *, return_indices=False):
+        """``l @ self @ r`` of smallest angle, ``l`` in ``left``, ``r`` in ``right``.
+
+        scipy's ``Rotation.reduce``: with ``left`` and ``right`` the symmetry groups
+        (e.g. :meth:`create_group`) of two objects related by ``self``, the
+        smallest rotation that aligns them. ``None`` is the identity alone. With
+        ``return_indices=True`` returns ``(reduced, left_index, right_index)``,
+        integer arrays of the batch shape (None for a group not given). Runs on
+        the rotations' array namespace (a matrix product and an argmax); see
+        :func:`rigidkit.functional.symmetry.quat_reduce`.
+
+        >>> R = Rotation.from_rotvec([0.0, 0.0, 1.6])
+        >>> reduced = R.reduce(right=Rotation.create_group("C4"))
+        >>> float(np.round(reduced.angle, 12))            # 1.6 - pi/2
+        0.029203673205
+        """
+        if left is None and right is None:
+            return (self, None, None) if return_indices else self
+        q, li, ri = _sym.quat_reduce(
+            self._quat,
+            None if left is None else left._quat,
+            None if right is None else right._quat,
+        )
+        reduced = Rotation._wrap(q)
+        if not return_indices:
+            return reduced
+        return reduced, (None if left is None else li), (None if right is None else ri)
 
     @classmethod
     def random(cls, shape=(), rng=None, *, dtype=None):
