@@ -51,6 +51,16 @@ def euler_product_order(reverse, a0, a1, a2):
 
 
 @helper
+def parity_sines_cosines(parity, t1, t2, t3):
+    """``(S1, C1, S2, C2, S3, C3)``, ``S_k = parity sin t_k``, ``C_k = cos t_k``."""
+    return (
+        parity * sin(t1), cos(t1),
+        parity * sin(t2), cos(t2),
+        parity * sin(t3), cos(t3),
+    )  # fmt: skip
+
+
+@helper
 def body_or_world(body, bod, world):
     """The 9 entries ``bod`` for ``body == 1``, else ``world``."""
     b = body == 1
@@ -73,12 +83,7 @@ def euler_rate_columns(parity, proper, body, t1, t2, t3):
 
     See the module docstring for the table.
     """
-    s1 = parity * sin(t1)
-    c1 = cos(t1)
-    s2 = parity * sin(t2)
-    c2 = cos(t2)
-    s3 = parity * sin(t3)
-    c3 = cos(t3)
+    s1, c1, s2, c2, s3, c3 = parity_sines_cosines(parity, t1, t2, t3)
     pr = proper == 1
     world = (
         1.0, 0.0, 0.0,
@@ -147,12 +152,7 @@ def euler_rate_inverse_rows(parity, proper, body, t1, t2, t3):
     denominator so the rows stay finite at the lock (the caller rejects it by the
     returned ``D``).
     """
-    s1 = parity * sin(t1)
-    c1 = cos(t1)
-    s2 = parity * sin(t2)
-    c2 = cos(t2)
-    s3 = parity * sin(t3)
-    c3 = cos(t3)
+    s1, c1, s2, c2, s3, c3 = parity_sines_cosines(parity, t1, t2, t3)
     pr = proper == 1
     d = where(pr, s2, c2)
     k = 1.0 / where(abs(d) > 0.0, d, 1.0)
@@ -193,18 +193,30 @@ def permuted_to_world_3(e1, e2, p0, p1, p2):
 
 
 @helper
-def matrix_entries_from_columns(e1, e2, reverse, scale, c):
-    """Row-major ``E`` on axes ``(x, y, z)`` and angles in sequence order.
+def triples_in_sequence_order(e1, e2, reverse, v):
+    """``v[0:3], v[3:6], v[6:9]`` (product order, permuted coordinates) in sequence order.
 
-    ``c`` holds the columns in permuted coordinates and product order; the
-    sequence's first angle is the product's last for extrinsic sequences.
+    Each triple on axes ``(x, y, z)``; the sequence's first angle is the
+    product's last for extrinsic sequences.
     """
     rev = reverse == 1
     k0 = where(rev, 2, 0)
     k2 = where(rev, 0, 2)
-    col0 = permuted_to_world_3(e1, e2, c[3 * k0], c[3 * k0 + 1], c[3 * k0 + 2])
-    col1 = permuted_to_world_3(e1, e2, c[3], c[4], c[5])
-    col2 = permuted_to_world_3(e1, e2, c[3 * k2], c[3 * k2 + 1], c[3 * k2 + 2])
+    return (
+        permuted_to_world_3(e1, e2, v[3 * k0], v[3 * k0 + 1], v[3 * k0 + 2]),
+        permuted_to_world_3(e1, e2, v[3], v[4], v[5]),
+        permuted_to_world_3(e1, e2, v[3 * k2], v[3 * k2 + 1], v[3 * k2 + 2]),
+    )
+
+
+@helper
+def matrix_entries_from_columns(e1, e2, reverse, scale, c):
+    """Row-major ``E`` on axes ``(x, y, z)`` and angles in sequence order.
+
+    ``c`` holds the columns in permuted coordinates and product order
+    (:func:`triples_in_sequence_order`).
+    """
+    col0, col1, col2 = triples_in_sequence_order(e1, e2, reverse, c)
     return (
         scale * col0[0], scale * col1[0], scale * col2[0],
         scale * col0[1], scale * col1[1], scale * col2[1],
@@ -216,6 +228,21 @@ def matrix_entries_from_columns(e1, e2, reverse, scale, c):
 def dot3(ax, ay, az, bx, by, bz):
     """``a . b``."""
     return ax * bx + ay * by + az * bz
+
+
+@helper
+def rates_from_inverse_rows(reverse, scale, r, p0, p1, p2):
+    """``E^-1 p`` in sequence order, and :func:`lock_sine`.
+
+    ``r`` from :func:`euler_rate_inverse_rows`, ``p`` in permuted coordinates;
+    divided by ``scale`` (rates in the angles' unit).
+    """
+    inv = 1.0 / scale
+    u1 = inv * dot3(r[0], r[1], r[2], p0, p1, p2)
+    u2 = inv * dot3(r[3], r[4], r[5], p0, p1, p2)
+    u3 = inv * dot3(r[6], r[7], r[8], p0, p1, p2)
+    rev = reverse == 1
+    return (where(rev, u3, u1), u2, where(rev, u1, u3), lock_sine(r[9]))
 
 
 _PARAMS = ("e1", "e2", "parity", "proper", "reverse", "body", "scale")
@@ -257,13 +284,8 @@ def rate_matrix_inverse_from_euler(
     """
     t1, t2, t3 = euler_product_order(reverse, a0 * scale, a1 * scale, a2 * scale)
     r = euler_rate_inverse_rows(parity, proper, body, t1, t2, t3)
-    rev = reverse == 1
-    k0 = where(rev, 2, 0)
-    k2 = where(rev, 0, 2)
+    row0, row1, row2 = triples_in_sequence_order(e1, e2, reverse, r)
     inv = 1.0 / scale
-    row0 = permuted_to_world_3(e1, e2, r[3 * k0], r[3 * k0 + 1], r[3 * k0 + 2])
-    row1 = permuted_to_world_3(e1, e2, r[3], r[4], r[5])
-    row2 = permuted_to_world_3(e1, e2, r[3 * k2], r[3 * k2 + 1], r[3 * k2 + 2])
     return (
         inv * row0[0], inv * row0[1], inv * row0[2],
         inv * row1[0], inv * row1[1], inv * row1[2],
@@ -298,12 +320,7 @@ def euler_rates_from_omega(
     p0 = w[e1]
     p1 = w[e2]
     p2 = w[m]
-    inv = 1.0 / scale
-    u1 = inv * dot3(r[0], r[1], r[2], p0, p1, p2)
-    u2 = inv * dot3(r[3], r[4], r[5], p0, p1, p2)
-    u3 = inv * dot3(r[6], r[7], r[8], p0, p1, p2)
-    rev = reverse == 1
-    return (where(rev, u3, u1), u2, where(rev, u1, u3), lock_sine(r[9]))
+    return rates_from_inverse_rows(reverse, scale, r, p0, p1, p2)
 
 
 @kernel(inputs=[(3,), (3,), (3,)], outputs=[(3,)], params=_PARAMS)
@@ -336,9 +353,4 @@ def euler_accelerations_from_alpha(
     p0 = al[e1] - (dc[0] * u1 + dc[3] * u2 + dc[6] * u3)
     p1 = al[e2] - (dc[1] * u1 + dc[4] * u2 + dc[7] * u3)
     p2 = al[m] - (dc[2] * u1 + dc[5] * u2 + dc[8] * u3)
-    inv = 1.0 / scale
-    g1 = inv * dot3(r[0], r[1], r[2], p0, p1, p2)
-    g2 = inv * dot3(r[3], r[4], r[5], p0, p1, p2)
-    g3 = inv * dot3(r[6], r[7], r[8], p0, p1, p2)
-    rev = reverse == 1
-    return (where(rev, g3, g1), g2, where(rev, g1, g3), lock_sine(r[9]))
+    return rates_from_inverse_rows(reverse, scale, r, p0, p1, p2)
