@@ -144,6 +144,7 @@ def euler_rate_matrix_derivative(seq, angles, rates, *, frame=None, degrees=Fals
     Returns
     -------
     array, shape (..., 3, 3)
+        Laid out as :func:`euler_rate_matrix`, per unit time.
 
     Examples
     --------
@@ -161,10 +162,8 @@ def angular_velocity_from_euler_rates(seq, angles, rates, *, frame=None, degrees
 
     Parameters
     ----------
-    seq, angles, frame, degrees
-        As in :func:`euler_rate_matrix`.
-    rates : array_like, shape (..., 3)
-        ``d(angles)/dt``, in ``seq`` order.
+    seq, angles, rates, frame, degrees
+        As in :func:`euler_rate_matrix_derivative`.
 
     Returns
     -------
@@ -207,6 +206,8 @@ def euler_rates(seq, angles, omega, *, frame=None, degrees=False, tol=None):
     Raises
     ------
     GimbalLockError
+        Where the middle angle is within ``tol`` of the lock (see
+        :func:`euler_rate_matrix_inverse`).
 
     Examples
     --------
@@ -271,10 +272,13 @@ def euler_accelerations(seq, angles, rates, alpha, *, frame=None, degrees=False,
     Returns
     -------
     array, shape (..., 3)
+        ``d2(angles)/dt2`` in ``seq`` order (degrees per unit time squared with
+        ``degrees=True``).
 
     Raises
     ------
     GimbalLockError
+        As :func:`euler_rates`.
 
     Examples
     --------
