@@ -106,9 +106,13 @@ def integrate(x0, rate, dt, method, fn, *, width, what, one, rk4, chain=None, bo
 
 
 def _samples(rate, width, what, fn):
+    shape = tuple(rate.shape) if hasattr(rate, "shape") else np.shape(rate)
+    if len(shape) < 2 or shape[-1] != width:
+        hint = "; a 1-D log w of N samples is w[:, None]" if width == 1 else ""
+        raise ShapeError(
+            f"{fn}: {what} must have shape (..., N, {width}), got {shape}{hint}"
+        )
     r = finite_array(rate, (width,), what)
-    if r.ndim < 2:
-        raise ShapeError(f"{fn}: {what} must have shape (..., N, {width}), got {r.shape}")
     if isinstance(r, np.ndarray) and r.dtype.kind != "f":
         r = r.astype(np.float64)
     return r
