@@ -117,19 +117,82 @@ def test_exact_method_equals_a_scipy_rotation_loop(rng):
 
 
 def test_batched_trajectories_and_both_scan_bindings(rng, monkeypatch):
-    """Many trajectories at once; the numba scan and the prefix product agree."""
+    """Many trajectories at once; the compiled scan and the prefix product agree."""
+    from rigidkit.kernels import kinematics_integration as kint
+
     w = rng.standard_normal((3, 4, 500, 3))
     R0 = rk.Rotation.random((4,), rng=2)  # broadcasts against (3, 4)
     dt = rng.uniform(0.001, 0.01, 500)
+    _scan.wait(kint.so3_chain, np.float64)
+    ran = []
+    real = _scan._numba_product
+    monkeypatch.setattr(_scan, "_numba_product", lambda *a: ran.append(1) or real(*a))
     for method in ("exact", "rk4"):
+        monkeypatch.setattr(_scan, "COMPILE_MIN", 1000)  # 6,000 steps: compiled
         a = K.integrate_angular_velocity(R0, w, dt, frame="body", method=method)
-        assert a.shape == (3, 4, 501)
-        monkeypatch.setattr(_scan, "COMPILE_MIN", 10**12)  # force the prefix product
+        assert a.shape == (3, 4, 501) and ran
+        monkeypatch.setattr(_scan, "COMPILE_MIN", 10**12)  # the prefix product
+        ran.clear()
         b = K.integrate_angular_velocity(R0, w, dt, frame="body", method=method)
-        monkeypatch.undo()
+        assert not ran
         assert angle(a, b).max() < 1e-13
         one = K.integrate_angular_velocity(R0[2], w[1, 2], dt, frame="body", method=method)
         assert angle(a[1, 2], one).max() < 1e-14
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 5, 8, 13, 64, 100])
+def test_prefix_product_of_every_length(n, rng):
+    """The pairwise prefix scheme equals the step-by-step product at odd and even
+    lengths (the recursion's ends), both frames."""
+    from rigidkit.kernels import kinematics_integration as kint
+
+    q0 = rk.Rotation.random((2,), rng=n).as_quat()
+    inc = rk.Rotation.random((2, n), rng=n + 1).as_quat()
+    for body in (0, 1):
+        got = _scan._prefix_product(kint.so3_chain, body, q0, inc, (2,), np)
+        want = [q0]
+        for k in range(n):
+            a, b = rk.Rotation.from_quat(want[-1]), rk.Rotation.from_quat(inc[:, k])
+            want.append((a @ b if body else b @ a).as_quat())
+        want = rk.Rotation.from_quat(np.stack(want, axis=1))
+        assert angle(rk.Rotation.from_quat(got), want).max() < 1e-14
+
+
+def test_no_call_compiles_the_scan(rng, monkeypatch):
+    """A cold scan is built on the engine's background thread, never the caller's;
+    calls made before it is ready get the prefix product, later ones the scan."""
+    import threading
+
+    from rigidkit._engine import numba_backend
+
+    if not numba_backend.available():
+        pytest.skip("numba is not available")
+    built_on = []
+    real = _scan._build
+
+    def build(*args):
+        built_on.append(threading.current_thread() is threading.main_thread())
+        return real(*args)
+
+    # A cold start: no scan ready, no job queued.
+    monkeypatch.setattr(_scan, "_SCANS", {})
+    monkeypatch.setattr(numba_backend, "_PENDING", {})
+    monkeypatch.setattr(_scan, "_build", build)
+    monkeypatch.setattr(_scan, "COMPILE_MIN", 2000)
+    w = rng.standard_normal((3000, 3)).astype(np.float32)
+    R0 = rk.Rotation.identity(dtype=np.float32)
+    first = K.integrate_angular_velocity(R0, w, 1e-3, frame="world")
+    numba_backend.drain()
+    assert built_on == [False]
+    assert ("so3_chain", 4, "f") in _scan._SCANS
+    ran = []
+    real_product = _scan._numba_product
+    monkeypatch.setattr(
+        _scan, "_numba_product", lambda *a: ran.append(1) or real_product(*a)
+    )
+    second = K.integrate_angular_velocity(R0, w, 1e-3, frame="world")
+    assert ran and second.dtype == np.float32
+    assert angle(first, second).max() < 1e-5
 
 
 def test_float32_and_torch_jax_paths(rng, torch, jnp):
