@@ -55,6 +55,10 @@ _LAZY = {
     "align_points": ("applications.alignment", "align_points"),
     "kinematics": ("applications.kinematics", None),
     "jacobians": ("applications.jacobians", None),
+    "geodesic_distance": ("objects.rotation", "geodesic_distance"),
+    "chordal_distance": ("objects.rotation", "chordal_distance"),
+    "quat_continuous": ("functional.sequences", "quat_continuous"),
+    "unwrap_euler": ("functional.sequences", "unwrap_euler"),
 }
 
 # The public module paths predate the layered tree (docs/architecture.md):
@@ -135,6 +139,11 @@ __all__ = [
     "BSplineSE3",
     "align_vectors",
     "align_points",
+    # distances and sequences of rotations
+    "geodesic_distance",
+    "chordal_distance",
+    "quat_continuous",
+    "unwrap_euler",
     # functional layers
     "conversions",
     "euler",

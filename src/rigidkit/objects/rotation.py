@@ -16,14 +16,18 @@ from .._validate import as_array, to_numpy
 from ..functional import averaging as _avg
 from ..functional import conversions as _conv
 from ..functional import davenport as _dav
+from ..functional import distances as _dist
 from ..functional import euler
 from ..functional import interpolation as _interp
+from ..functional import rot6d as _r6
+from ..functional import sequences as _seq
+from ..functional import swing_twist as _st
 from ..functional import symmetry as _sym
 from ._batch import BatchedArray, batch_shape
 from ._frozen import frozen
 from .group import LieGroup
 
-__all__ = ["Rotation"]
+__all__ = ["Rotation", "geodesic_distance", "chordal_distance"]
 
 
 class Rotation(BatchedArray, LieGroup, family="space", rank=0):
@@ -217,6 +221,22 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
         return reduced, (None if left is None else li), (None if right is None else ri)
 
     @classmethod
+    def from_6d(cls, rot6d):
+        """From the continuous 6D representation (Zhou et al. 2019), shape (..., 6).
+
+        The first two COLUMNS ``a1, a2`` of the matrix, ``(R00, R10, R20, R01, R11,
+        R21)``, any scale: ``R = [b1 b2 b1 x b2]`` by Gram-Schmidt. (pytorch3d's
+        ``rotation_6d`` holds the first two rows: that is ``R.inv().as_6d()``.)
+        Zero or parallel vectors raise :class:`~rigidkit.DegenerateInputError`.
+        See :mod:`rigidkit.functional.rot6d`.
+
+        >>> R = Rotation.from_6d([2.0, 0.0, 0.0, 1.0, 3.0, 0.0])
+        >>> np.round(R.as_quat(), 12) + 0.0
+        array([1., 0., 0., 0.])
+        """
+        return cls._wrap(_r6.quat_from_rot6d(rot6d))
+
+    @classmethod
     def random(cls, shape=(), rng=None, *, dtype=None):
         """Uniformly distributed (Haar) rotations, from a normalised 4D Gaussian.
 
@@ -266,6 +286,16 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
         """
         axis, angle = _conv.axis_angle_from_quat_unchecked(self._quat)
         return axis, (angle * (180.0 / math.pi) if degrees else angle)
+
+    def as_6d(self):
+        """The 6D representation: the first two matrix columns, shape (..., 6).
+
+        ``(R00, R10, R20, R01, R11, R21)`` (Zhou et al. 2019); see :meth:`from_6d`.
+
+        >>> np.round(Rotation.from_rotvec([0.0, 0.0, np.pi / 2]).as_6d(), 12) + 0.0
+        array([ 0.,  1.,  0., -1.,  0.,  0.])
+        """
+        return _r6.rot6d_from_quat(self._quat)
 
     def as_mrp(self):
         """Modified Rodrigues parameters ``axis * tan(angle / 4)``, norm <= 1."""
@@ -332,6 +362,64 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
         """
         return _conv.quat_angle_between_unchecked(self._quat, other._quat) <= atol
 
+    def angle_to(self, other):
+        """Geodesic distance: the angle (radians, [0, pi]) of ``self.inv() @ other``.
+
+        ``|log(R1^T R2)|``, the Riemannian distance on SO(3), shape of the
+        broadcast batches; equal to scipy's ``(r1.inv() * r2).magnitude()``. See
+        also :meth:`chordal_distance` and :func:`rigidkit.geodesic_distance`.
+
+        >>> a = Rotation.from_rotvec([0.0, 0.0, 0.5])
+        >>> float(np.round(a.angle_to(Rotation.from_rotvec([0.0, 0.0, -0.25])), 12))
+        0.75
+        """
+        return _conv.quat_angle_between_unchecked(self._quat, other._quat)
+
+    def chordal_distance(self, other):
+        """Chordal distance ``|R1 - R2|_F`` (Frobenius), ``2 sqrt(2) sin(theta/2)``.
+
+        ``theta`` is :meth:`angle_to`; in [0, 2 sqrt(2)]. See
+        :mod:`rigidkit.functional.distances`.
+
+        >>> a = Rotation.identity()
+        >>> float(np.round(a.chordal_distance(Rotation.from_rotvec([np.pi, 0, 0])), 12))
+        2.828427124746
+        """
+        return _dist.chordal_distance_unchecked(self._quat, other._quat)
+
+    def swing_twist(self, axis):
+        """``(swing, twist)`` Rotations with ``self = swing @ twist``, twist about ``axis``.
+
+        ``twist`` (applied first) turns about ``axis`` (..., 3), by an angle in [-pi,
+        pi]; ``swing`` about an axis orthogonal to it. Where the swing is a half
+        turn every twist would do and the twist is the identity. For ``self =
+        twist' @ swing'`` use ``s, t = self.inv().swing_twist(axis)``, ``twist' =
+        t.inv()``, ``swing' = s.inv()``. See :mod:`rigidkit.functional.swing_twist`.
+
+        >>> R = Rotation.from_euler("ZYX", [0.7, 0.2, 0.0])  # yaw, then pitch (body)
+        >>> swing, twist = R.swing_twist([0.0, 1.0, 0.0])
+        >>> float(np.round(twist.angle, 12)), bool((swing @ twist).approx_equal(R))
+        (0.2, True)
+        """
+        swing, twist = _st.swing_twist(self._quat, axis)
+        return Rotation._wrap(swing), Rotation._wrap(twist)
+
+    def continuous(self, *, axis=-1):
+        """The same rotations with quaternion signs continuous along batch ``axis``.
+
+        Each quaternion is flipped to ``-q`` where needed so that neighbours have
+        ``q_k . q_k+1 >= 0`` (the first keeps its sign): for plots and learning
+        targets; the rotations are unchanged. ``axis`` is a batch axis (default
+        the last). See :func:`rigidkit.quat_continuous`.
+        """
+        nb = len(self.shape)
+        if not -nb <= axis < nb:
+            raise np.exceptions.AxisError(
+                f"axis {axis} is out of bounds for a batch of {nb} dimensions"
+            )
+        q = _seq.quat_continuous(self._quat, axis=(axis % nb) - nb - 1)
+        return Rotation._wrap(q)
+
     def magnitude(self):
         """Rotation angle in [0, pi] (same as :attr:`angle`)."""
         return self.angle
@@ -369,3 +457,29 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
     def _repr_single(self):
         vals = ", ".join(f"{c:.6g}" for c in to_numpy(self._quat).tolist())
         return f"Rotation.from_quat([{vals}])"
+
+
+def geodesic_distance(a, b):
+    """Geodesic distance between Rotations: the angle of ``a.inv() @ b``, [0, pi].
+
+    Radians, shape of the broadcast batches; :meth:`Rotation.angle_to`.
+
+    >>> import rigidkit as rk
+    >>> a, b = rk.Rotation.identity(), rk.Rotation.from_rotvec([0.0, 0.3, 0.0])
+    >>> float(np.round(rk.geodesic_distance(a, b), 12))
+    0.3
+    """
+    return a.angle_to(b)
+
+
+def chordal_distance(a, b):
+    """Chordal distance between Rotations, ``|R_a - R_b|_F`` (Frobenius), [0, 2.83].
+
+    ``2 sqrt(2) sin(theta / 2)`` of the geodesic angle; :meth:`Rotation.chordal_distance`.
+
+    >>> import rigidkit as rk
+    >>> a, b = rk.Rotation.identity(), rk.Rotation.from_rotvec([0.0, 0.3, 0.0])
+    >>> float(np.round(rk.chordal_distance(a, b), 12))  # 2 sqrt(2) sin(0.15)
+    0.42267486736
+    """
+    return a.chordal_distance(b)
