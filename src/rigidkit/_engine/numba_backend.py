@@ -202,22 +202,35 @@ def module_source(kernel, bcast=()) -> str:
 
 def _module(kernel, bcast):
     """Import the generated module of ``kernel`` for broadcast pattern ``bcast``."""
+    src = module_source(kernel, bcast)
+    return import_source(
+        f"rigidkit_k_{kernel.name}", src, f"<rigidkit kernel {kernel.name}>"
+    )
+
+
+def import_source(prefix: str, src: str, label: str):
+    """Import generated source ``src``: ``(module, cached)``.
+
+    The module is named ``prefix`` and a hash of ``src`` and numba's version, and
+    written once to the cache folder, since numba's disk cache needs the function
+    in a real file (``cached`` False: no writable folder, the source is executed
+    in memory and numba must not cache it). ``label`` names it in tracebacks then.
+    """
     import hashlib
     import importlib.util
     import tempfile
 
     import numba
 
-    src = module_source(kernel, bcast)
     digest = hashlib.sha1((src + numba.__version__).encode()).hexdigest()[:16]
-    modname = f"rigidkit_k_{kernel.name}_{digest}"
+    modname = f"{prefix}_{digest}"
     folder = _cache_dir()
     with _LOCK:
         if modname in sys.modules:
             return sys.modules[modname], folder is not None
         if folder is None:
             module = type(sys)(modname)
-            exec(compile(src, f"<rigidkit kernel {kernel.name}>", "exec"), module.__dict__)
+            exec(compile(src, label, "exec"), module.__dict__)
             sys.modules[modname] = module
             return module, False
         path = os.path.join(folder, modname + ".py")

@@ -77,35 +77,14 @@ def _build(chain, width: int, dtype):
     int64; ``x0`` (n, W) and ``inc`` (n, N, W) read-only; ``out`` (n, N + 1, W)),
     so a call never compiles again.
     """
-    import hashlib
-    import importlib.util
-    import sys
-    import tempfile
-
     import numba
     from numba import types
 
-    src = _scan_source(chain, width)
-    digest = hashlib.sha1((src + numba.__version__).encode()).hexdigest()[:16]
-    modname = f"rigidkit_scan_{chain.name}_{digest}"
-    folder = _nb._cache_dir()
-    module = sys.modules.get(modname)
-    if module is None:
-        module = type(sys)(modname)
-        if folder is None:
-            exec(compile(src, f"<rigidkit scan {chain.name}>", "exec"), module.__dict__)
-        else:
-            # numba's disk cache needs the function in a real file.
-            path = os.path.join(folder, modname + ".py")
-            if not os.path.exists(path):
-                fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
-                with os.fdopen(fd, "w") as fh:
-                    fh.write(src)
-                os.replace(tmp, path)
-            spec = importlib.util.spec_from_file_location(modname, path)
-            module = importlib.util.module_from_spec(spec)
-            spec.loader.exec_module(module)
-        sys.modules[modname] = module
+    module, cache = _nb.import_source(
+        f"rigidkit_scan_{chain.name}",
+        _scan_source(chain, width),
+        f"<rigidkit scan {chain.name}>",
+    )
     dt = types.float32 if dtype.itemsize == 4 else types.float64
     sig = types.void(
         types.int64,
@@ -113,9 +92,7 @@ def _build(chain, width: int, dtype):
         types.Array(dt, 3, "C", readonly=True),
         types.Array(dt, 3, "C"),
     )
-    scan = numba.njit([sig], cache=folder is not None, nogil=True, error_model="numpy")(
-        module.scan
-    )
+    scan = numba.njit([sig], cache=cache, nogil=True, error_model="numpy")(module.scan)
     _SCANS[(chain.name, width, dtype.char)] = scan
     return scan
 

@@ -38,6 +38,7 @@ from ..._engine.namespace import device_of, is_numpy, namespace_of
 from ..._validate import finite_array
 from ...errors import ShapeError
 from ...kernels import kinematics_integration as _k
+from ...kernels import kinematics_planar as _kp
 from ...objects.rotation import Rotation
 from ...objects.transform import Transform
 from . import _scan
@@ -84,16 +85,28 @@ def _increments(one, rk4, method, rate, h):
     return rk4(rate, mid, end, h)
 
 
-def integrate(x0, rate, dt, method, fn, *, width, what, one, rk4, chain=None, body=0):
-    """The trajectory ``(..., N + 1, W)`` from ``x0`` (..., W) and the rate samples.
+#: Per group: the rate's width and name, the step kernels (one step, RKMK4) and the
+#: chain of the running product (None for SO(2), whose steps are angles, summed).
+GROUPS = {
+    "so3": (3, "angular velocity", _k.so3_increment, _k.so3_increment_rk4, _k.so3_chain),
+    "se3": (6, "twist", _k.se3_increment, _k.se3_increment_rk4, _k.se3_chain),
+    "so2": (1, "angular velocity", _kp.so2_increment, _kp.so2_increment_rk4, None),
+    "se2": (3, "planar twist", _kp.se2_increment, _kp.se2_increment_rk4, _kp.se2_chain),
+}
+
+
+def integrate(group, x0, rate, dt, method, fn, body=0):
+    """The trajectory ``(..., N + 1, W)`` of ``group`` from ``x0`` (..., W).
 
     Shared by every group (``x0`` in the group's storage: quaternions, poses,
     complex numbers): validates the rates (``(..., N, width)``), the steps and
-    the method, makes the increments (``one``, ``rk4``: see :func:`_increments`)
-    and chains them with the kernel ``chain`` (:func:`._scan.running_product`).
-    Without ``chain`` (an abelian group written additively, SO(2) angles) the
-    result is ``x0`` and the running sums of the increments, shape (..., N + 1, 1).
+    the method, makes the increments (:func:`_increments`) and chains them
+    (:func:`._scan.running_product`). For SO(2) the result is ``x0`` and the
+    running sums of the angle increments, shape (..., N + 1, 1).
     """
+    width, what, one, rk4, chain = GROUPS[group]
+    if rk4.params:
+        rk4 = partial(rk4, body)
     _method(method, fn)
     r = _samples(rate, width, what, fn)
     h = _steps(dt, r, fn)
@@ -162,11 +175,7 @@ def integrate_angular_velocity(R0, omega, dt, *, frame=None, method="exact"):
     body = body_flag(frame, fn)
     as_object = isinstance(R0, Rotation)
     q0 = R0.as_quat() if as_object else Rotation.from_matrix(rotation_matrix(R0)).as_quat()
-    q = integrate(
-        q0, omega, dt, method, fn, width=3, what="angular velocity",
-        one=_k.so3_increment, rk4=partial(_k.so3_increment_rk4, body),
-        chain=_k.so3_chain, body=body,
-    )  # fmt: skip
+    q = integrate("so3", q0, omega, dt, method, fn, body)
     traj = Rotation._wrap(q)
     return traj if as_object else traj.as_matrix()
 
@@ -212,11 +221,7 @@ def integrate_twist(T0, twist, dt, *, frame=None, method="exact"):
         p0 = T0._pose
     else:
         p0 = Transform.from_matrix(homogeneous_matrix(T0))._pose
-    p = integrate(
-        p0, twist, dt, method, fn, width=6, what="twist",
-        one=_k.se3_increment, rk4=partial(_k.se3_increment_rk4, body),
-        chain=_k.se3_chain, body=body,
-    )  # fmt: skip
+    p = integrate("se3", p0, twist, dt, method, fn, body)
     traj = Transform._wrap(p)
     return traj if as_object else traj.as_matrix()
 

@@ -18,8 +18,6 @@ array([3.])
 
 from __future__ import annotations
 
-from functools import partial
-
 from ...functional import se2 as _se2
 from ...functional import so2 as _so2
 from ...kernels import kinematics_planar as _k
@@ -301,10 +299,7 @@ def integrate_angular_velocity(R0, omega, dt, *, frame=None, method="exact"):
     body_flag(frame, fn)
     as_object = isinstance(R0, Rotation2D)
     z0 = (R0 if as_object else Rotation2D.from_matrix(_rotation(R0)))._data
-    z0, theta = integrate(
-        z0, omega, dt, method, fn, width=1, what="angular velocity",
-        one=_k.so2_increment, rk4=_k.so2_increment_rk4,
-    )  # fmt: skip
+    z0, theta = integrate("so2", z0, omega, dt, method, fn)
     z = _kso2.complex_multiply(z0[..., None, :], _kso2.complex_from_angle(theta))
     traj = Rotation2D._wrap(z)
     return traj if as_object else traj.as_matrix()
@@ -348,10 +343,6 @@ def integrate_twist(T0, twist, dt, *, frame=None, method="exact"):
     body = body_flag(frame, fn)
     as_object = isinstance(T0, Transform2D)
     p0 = (T0 if as_object else Transform2D.from_matrix(_transform(T0)))._data
-    p = integrate(
-        p0, twist, dt, method, fn, width=3, what="planar twist",
-        one=_k.se2_increment, rk4=partial(_k.se2_increment_rk4, body),
-        chain=_k.se2_chain, body=body,
-    )  # fmt: skip
+    p = integrate("se2", p0, twist, dt, method, fn, body)
     traj = Transform2D._wrap(p)
     return traj if as_object else traj.as_matrix()
