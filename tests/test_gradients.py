@@ -505,3 +505,37 @@ def test_jax_forward_mode_with_concrete_operands(jax, rng):
     J_fd = fd_jacobian(op, q2[None], ("random",))[0]
     J = jax.jacfwd(lambda x: (R_fixed @ R.from_quat(x)).as_quat())(jnp.asarray(q2))
     np.testing.assert_allclose(np.asarray(J), J_fd, atol=1e-8)
+
+
+def test_cos_of_norm_across_its_threshold():
+    """The series that gives ``exp`` its Hessian at 0 (``cos`` as a polynomial of
+    ``|r|^2`` below ``|r| = 0.03``) against mpmath on both sides of its threshold,
+    within 1 ulp-ish, on Python floats, vectorised NumPy and the numba loop (through
+    ``quat_from_rotvec``, whose ``w`` is ``cos(|r|/2)``)."""
+    mp = pytest.importorskip("mpmath")
+    from rigidkit._engine.primitives import xp_bindings
+    from rigidkit.kernels import rotvec
+
+    t = 0.03 * (1 + np.array([-1e-3, -1e-8, 0.0, 1e-8, 1e-3]))
+    n = np.concatenate([np.logspace(-12, 0.5, 120), t, [np.nextafter(0.03, 0), 0.0]])
+    with mp.workdps(40):
+        ref = np.array([float(mp.cos(mp.mpf(float(x)))) for x in n])
+    h = rotvec.cos_of_norm
+    got = {
+        "python": np.array([h(float(x * x), float(x)) for x in n]),
+        "numpy-xp": h.bound(xp_bindings(np, np.dtype(np.float64), None))(n * n, n),
+    }
+    axes = np.random.default_rng(5).standard_normal((len(n), 3))
+    r = 2 * n[:, None] * axes / np.linalg.norm(axes, axis=-1, keepdims=True)
+    got = {label: (g, ref, 0.0) for label, g in got.items()}
+    with mp.workdps(40):  # the exact norm of the rounded vectors
+        ref_r = [
+            float(mp.cos(mp.sqrt(sum(mp.mpf(float(c)) ** 2 for c in v)) / 2)) for v in r
+        ]
+    # numba rounds |r| itself (1 ulp), which moves cos(|r|/2) by n tan(n) ulp.
+    got["numba"] = (rotvec.quat_from_rotvec(r, backend="numba")[:, 0], ref_r, 1.0)
+    for label, (g, want, rounded_norm) in got.items():
+        err = np.abs(g - want) / np.asarray(want)
+        bound = 2.3e-16 * (1.0 + rounded_norm * n * np.tan(n))
+        i = int(np.argmax(err / bound))
+        assert err[i] <= bound[i], f"{label}: rel. error {err[i]:.3g} at n = {n[i]!r}"

@@ -5,30 +5,57 @@ written once: the SE(3) and Sim(3) kernels call them for their rotation part.
 """
 
 from .._engine import helper, kernel
-from .coefficients import atan_ratio, norm3, sinc, versinc2
+from .coefficients import atan_ratio, norm3, sinc
 from .matrix import matrix_entries_from_quat
 from .quaternion import quat_hemisphere
+
+
+@helper(numerical=True)
+def cos_of_norm(n2, n):
+    """``cos(n)`` of a norm ``n = |r|``, given ``n2 = |r|^2`` summed from ``r`` too.
+
+    Autodiff of ``cos`` through the norm (:func:`~.coefficients.norm3`, whose
+    derivatives at ``r = 0`` are all 0) gives a Hessian of 0 at ``r = 0`` instead of
+    ``-I``: ``|r|`` has no second derivative there. Below ``n2 < 9e-4`` (``n <
+    0.03``, the threshold of ``sinc``) the value is the series in ``n2``, a
+    polynomial in ``r`` whose derivatives of every order are exact: ``1 - n2/2 +
+    n2^2/24 - n2^3/720``, the omitted ``n^8/8!`` < 2e-17 there. Above, the plain
+    cosine, accurate to an ulp. The series is a few multiplications beside the
+    cosine, where ``1 - n2 versinc2(n)`` (the first fix) cost a second sine: 16.5
+    -> 24.7 ns per element in ``from_rotvec``.
+    """
+    series = 1.0 - 0.5 * n2 * (1.0 - n2 / 12.0 * (1.0 - n2 / 30.0))
+    return where(n2 < 9e-4, series, cos(n))
+
+
+@helper
+def half_angle_from_rotvec(rx, ry, rz):
+    """``(cos(theta/2), sin(theta/2)/theta, theta)``, ``theta = |r|``: the exponential
+    of SO(3) on quaternions is ``q = (c, s r)``.
+
+    ``sinc`` keeps small angles exact; a vector so small that ``|r|^2`` underflows
+    gives theta = 0 and q = (1, r/2), still right to the last bit. ``norm3`` keeps
+    the gradient finite (``dq/dr = I/2``) at ``r = 0``, where ``d|r|/dr`` is 0/0.
+
+    ``c = cos(theta/2)`` is :func:`cos_of_norm` of ``|r|^2 / 4``: through ``theta``
+    alone autodiff gets no second derivative at ``r = 0`` (``|r|`` has none;
+    ``norm3`` says 0), and the Hessian of ``c`` there came out 0 instead of
+    ``-I/4``. ``2 s^2`` is ``(1 - cos theta)/theta^2`` (``versinc2``, the same
+    expression), which the SE(3) exponential takes from here.
+    """
+    t2 = rx * rx + ry * ry + rz * rz
+    theta = norm3(rx, ry, rz)
+    half = 0.5 * theta
+    return (cos_of_norm(0.25 * t2, half), 0.5 * sinc(half), theta)
 
 
 @helper
 def quat_angle_from_rotvec(rx, ry, rz):
     """``(cos(theta/2), sin(theta/2)/theta * r)`` and ``theta = |r|``, as five scalars.
 
-    ``sinc`` keeps small angles exact; a vector so small that ``|r|^2`` underflows
-    gives theta = 0 and q = (1, r/2), still right to the last bit. ``norm3`` keeps
-    the gradient finite (``dq/dr = I/2``) at ``r = 0``, where ``d|r|/dr`` is 0/0.
-
-    Below ``theta = 1``, ``cos(theta/2)`` is ``1 - (|r|^2 / 4) versinc2(theta/2)``,
-    a function of ``|r|^2``: through ``theta`` alone autodiff gets no second
-    derivative at ``r = 0`` (``|r|`` has none; ``norm3`` says 0), so the Hessian of
-    ``w`` there came out 0 instead of ``-I/4``. The subtracted term is below 1/8
-    there, so this costs no accuracy; above 1 the plain cosine is as accurate.
+    See :func:`half_angle_from_rotvec`.
     """
-    theta = norm3(rx, ry, rz)
-    half = 0.5 * theta
-    s = 0.5 * sinc(half)
-    t2 = rx * rx + ry * ry + rz * rz
-    w = where(t2 < 1.0, 1.0 - 0.25 * t2 * versinc2(half), cos(half))
+    w, s, theta = half_angle_from_rotvec(rx, ry, rz)
     return (w, s * rx, s * ry, s * rz, theta)
 
 
@@ -61,7 +88,7 @@ def rotvec_entries_from_quat(w, x, y, z):
 def quat_from_rotvec(rx, ry, rz):
     """``q = (cos(theta/2), sin(theta/2)/theta * r)``, ``theta = |r|``.
 
-    See :func:`quat_angle_from_rotvec`.
+    See :func:`half_angle_from_rotvec`.
     """
     return quat_entries_from_rotvec(rx, ry, rz)
 
