@@ -13,8 +13,15 @@ Rows (issue 8):
   ``Rotation`` loop (one step per iteration) and numpy-quaternion's
   ``integrate_angular_velocity`` (an adaptive ODE solver over the sampled rate),
   both on a short trajectory;
+* the planar integrators (``kinematics.planar``) on 3.6 M steps: SO(2) (summed
+  angles, no compiled loop) and SE(2) (the compiled scan);
 * ``angular_velocity_from_samples`` (N = 1e6 samples) next to pytransform3d's
   ``quaternion_gradient`` (on 20,000 samples: it is a Python loop).
+
+``--first-call`` times instead the first ``integrate_angular_velocity`` call of a
+fresh interpreter (20,000 and 3.6 M steps), with an empty numba cache and again
+with the cache it left: no call compiles on the caller's thread, so the first
+calls run on the prefix product until the background thread has the scan.
 
 Every contender is first run on small inputs and compared with rigidkit (a
 disagreement is printed as ``CHECK``). A peer that is not installed is skipped
@@ -198,6 +205,22 @@ def rows(peers, n, rng):
         )
         counts["numpy-quaternion"] = short
     out["integrate_angular_velocity (ns/step)"] = (r, counts)
+    # the plane -------------------------------------------------------------------------
+    P = K.planar
+    V2 = rng.standard_normal((steps, 3))
+    r = {
+        "rigidkit SO(2) 1 x 3.6M": partial(
+            P.integrate_angular_velocity,
+            rk.Rotation2D.identity(),
+            V2[:, 2:],
+            1e-3,
+            frame="body",
+        ),
+        "rigidkit SE(2) 1 x 3.6M": partial(
+            P.integrate_twist, rk.Transform2D.identity(), V2, 1e-3, frame="body"
+        ),
+    }
+    out["planar integration (ns/step)"] = (r, {k: steps for k in r})
     # angular_velocity_from_samples -------------------------------------------------------
     t = np.arange(n) * 1e-3
     R = rk.Rotation.from_rotvec(np.cumsum(w * 1e-3, axis=0))
@@ -228,6 +251,46 @@ def warm(all_rows) -> None:
             drain(timeout=900)
 
 
+_FIRST_CALL = """
+import sys, time
+t0 = time.perf_counter()
+import numpy as np
+import rigidkit as rk
+n = int(sys.argv[1])
+w = np.random.default_rng(0).standard_normal((n, 3))
+t1 = time.perf_counter()
+rk.kinematics.integrate_angular_velocity(rk.Rotation.identity(), w, 1e-3, frame="body")
+t2 = time.perf_counter()
+rk.kinematics.integrate_angular_velocity(rk.Rotation.identity(), w, 1e-3, frame="body")
+t3 = time.perf_counter()
+print(t2 - t1, t3 - t2)
+"""
+
+
+def first_calls(repeat: int) -> None:
+    """First and second call of a fresh interpreter, empty and warm numba cache."""
+    import subprocess
+    import tempfile
+
+    table = []
+    for n in (20_000, 3_600_000):
+        for cache in ("empty", "warm"):
+            runs = []
+            for _ in range(repeat):
+                with tempfile.TemporaryDirectory() as folder:
+                    env = dict(os.environ, RIGIDKIT_CACHE_DIR=folder)
+                    for state in ("empty", "warm"):
+                        res = subprocess.run(
+                            [sys.executable, "-c", _FIRST_CALL, str(n)],
+                            env=env, capture_output=True, text=True, check=True,
+                        )  # fmt: skip
+                        if state == cache:
+                            runs.append([float(x) for x in res.stdout.split()])
+            first, second = np.median(np.array(runs), axis=0)
+            table.append([f"{n:,}", cache, C.fmt(first * 1e3), C.fmt(second * 1e3)])
+    print(C.table(["steps", "numba cache", "first call ms", "second call ms"], table))
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--n", type=int, default=1_000_000, help="elements per batch")
@@ -235,7 +298,13 @@ def main(argv=None):
     p.add_argument("--warmup", type=int, default=2)
     p.add_argument("--min-sample", type=float, default=0.05)
     p.add_argument("--json", metavar="FILE")
+    p.add_argument(
+        "--first-call", action="store_true", help="first calls in fresh processes"
+    )
     args = p.parse_args(argv)
+    if args.first_call:
+        first_calls(args.repeat)
+        return
     peers = Peers()
     py = platform.python_version()
     print(f"rigidkit {rk.__version__}, numpy {np.__version__}, python {py}")

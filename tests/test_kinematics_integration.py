@@ -195,6 +195,41 @@ def test_no_call_compiles_the_scan(rng, monkeypatch):
     assert angle(first, second).max() < 1e-5
 
 
+def test_a_scan_ready_mid_call_takes_over(rng, monkeypatch):
+    """Waiting for the scan, a long call runs the prefix product chunk by chunk
+    (each from the last state) and hands the rest to the scan once it is ready."""
+    from rigidkit.kernels import kinematics_integration as kint
+
+    _scan.wait(kint.so3_chain, np.float64)
+    key = ("so3_chain", 4, "d")
+    scan = _scan._SCANS[key]
+    w = rng.standard_normal((2, 1000, 3))
+    R0 = rk.Rotation.random((2,), rng=5)
+    monkeypatch.setattr(_scan, "COMPILE_MIN", 10**12)
+    ref = K.integrate_angular_velocity(R0, w, 0.01, frame="body", method="rk4")
+    monkeypatch.setattr(_scan, "COMPILE_MIN", 100)
+    monkeypatch.setattr(_scan, "CHUNK", 300)  # 150 steps of both trajectories
+    monkeypatch.setattr(_scan, "_SCANS", {})  # as if not built yet
+    monkeypatch.setattr(_scan, "prepare", lambda *a: None)
+    chunks, ran = [], []
+    real_prefix, real_numba = _scan._prefix_product, _scan._numba_product
+
+    def prefix(*a):
+        chunks.append(a[3].shape)
+        if len(chunks) == 2:
+            _scan._SCANS[key] = scan  # lands during the second chunk
+        return real_prefix(*a)
+
+    monkeypatch.setattr(_scan, "_prefix_product", prefix)
+    monkeypatch.setattr(
+        _scan, "_numba_product", lambda *a: ran.append(a[6]) or real_numba(*a)
+    )
+    got = K.integrate_angular_velocity(R0, w, 0.01, frame="body", method="rk4")
+    assert chunks == [(2, 150, 4)] * 2 and ran == [700]
+    assert got.shape == (2, 1001)
+    assert angle(got, ref).max() < 1e-13
+
+
 def test_float32_and_torch_jax_paths(rng, torch, jnp):
     w = rng.standard_normal((300, 3))
     ref = K.integrate_angular_velocity(

@@ -135,7 +135,9 @@ def running_product(chain, body: int, x0, inc):
 
     The batch shapes of ``x0`` and ``inc`` broadcast; ``chain(body, a, b)`` is the
     link (``a b`` for body frames, ``b a`` for world frames). The compiled scan
-    runs when it is ready (never waited for); otherwise the prefix product.
+    runs when it is ready (never waited for); otherwise the prefix product, by
+    chunks on NumPy, so that a scan that becomes ready during a long call serves
+    the rest of it.
     """
     xp = namespace_of(x0, inc)
     width = inc.shape[-1]
@@ -144,10 +146,12 @@ def running_product(chain, body: int, x0, inc):
     n = int(np.prod(batch, dtype=np.int64))
     if is_numpy(xp) and isinstance(inc, np.ndarray) and n * steps >= COMPILE_MIN:
         dtype = np.result_type(x0.dtype, inc.dtype)
-        scan = _SCANS.get((chain.name, width, dtype.char))
+        key = (chain.name, width, dtype.char)
+        scan = _SCANS.get(key)
         if scan is not None:
             return _numba_product(scan, body, x0, inc, batch, n, steps, width, dtype)
         prepare(chain, x0, inc, steps)
+        return _chunked_product(chain, body, key, x0, inc, batch, n, steps, dtype)
     if type(inc).__module__.startswith("jax") or type(x0).__module__.startswith("jax"):
         return _jax_prefix()(chain, int(body), x0, inc, batch)
     return _prefix_product(chain, body, x0, inc, batch, xp)
@@ -173,6 +177,35 @@ def _jax_prefix():
 
         _JAX_PREFIX = jax.jit(run, static_argnums=(0, 1, 4))
     return _JAX_PREFIX
+
+
+#: Elements (trajectories x steps) per chunk of a prefix product that waits for
+#: the compiled scan: ~0.1 s each, so a scan that lands mid-call takes over soon.
+CHUNK = 1 << 18
+
+
+def _chunked_product(chain, body, key, x0, inc, batch, n, steps, dtype):
+    """The NumPy prefix product chunk by chunk along the steps, each chunk starting
+    from the last state, switching to the compiled scan as soon as it is ready."""
+    width = inc.shape[-1]
+    out = np.empty(batch + (steps + 1, width), dtype)
+    out[..., 0, :] = x0
+    state = out[..., 0, :]
+    m = max(1, CHUNK // max(n, 1))
+    k = 0
+    while k < steps:
+        scan = _SCANS.get(key)
+        if scan is not None:
+            rest = inc[..., k:, :]
+            out[..., k:, :] = _numba_product(
+                scan, body, state, rest, batch, n, steps - k, width, dtype
+            )
+            break
+        part = _prefix_product(chain, body, state, inc[..., k : k + m, :], batch, np)
+        out[..., k + 1 : k + m + 1, :] = part[..., 1:, :]
+        k = min(k + m, steps)
+        state = out[..., k, :]
+    return out
 
 
 def _numba_product(scan, body, x0, inc, batch, n, steps, width, dtype):
