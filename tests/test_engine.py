@@ -184,6 +184,11 @@ SAMPLERS = {
         _quats(rng, n, span)[::-1],
     ],
     "so3.hat": lambda rng, n, span: [_vectors(rng, n)],
+    # Swing-twist of unit quaternions about unit axes (the functional normalises).
+    "swing_twist.swing_twist": lambda rng, n, span: [
+        (lambda q: q / np.linalg.norm(q, axis=-1, keepdims=True))(_quats(rng, n, span)),
+        _unit(rng, n, 3),
+    ],
     # Geodesics act on unit quaternions and poses built on them, t in [-1, 2].
     "geodesic.quat_power": lambda rng, n, span: [_quats(rng, n, span), _times(rng, n)],
     "geodesic.quat_slerp": lambda rng, n, span: [
@@ -474,6 +479,8 @@ SYMPY_SKIP = {
     "geodesic.pose_slerp_decoupled": "nested exp(t log) expression: SymPy runs for minutes",
     "geodesic.quat_slerp": "nested exp(t log) expression: SymPy runs for minutes",
     "geodesic.quat_power": "nested exp(t log) expression: SymPy runs for minutes",
+    "rot6d.quat_from_rot6d": "Gram-Schmidt inside Shepperd's branches: the symbolic "
+    "Piecewise compares NaN (its parts, normalize4 and quat_from_matrix, are checked)",
 }
 
 

@@ -55,6 +55,10 @@ def args_for(obj, name):
         "minus": (obj,),
         "approx_equal": (obj,),
         "distance_to": (obj,),
+        "angle_to": (obj,),
+        "chordal_distance": (obj,),
+        "swing_twist": (np.array([0.0, 0.0, 1.0]),),
+        "as_davenport": (np.eye(3)[[2, 0, 2]], "e"),
         "compose": (obj,),
         "reshape": (obj.shape,),
     }

@@ -413,6 +413,8 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
         the last). See :func:`rigidkit.quat_continuous`.
         """
         nb = len(self.shape)
+        if nb == 0:  # one rotation: nothing to be continuous with
+            return self
         if not -nb <= axis < nb:
             raise np.exceptions.AxisError(
                 f"axis {axis} is out of bounds for a batch of {nb} dimensions"
