@@ -7,7 +7,8 @@ quaternion needs: inverse, exp, log and the 4x4 product matrices.
 """
 
 from .._engine import kernel
-from .coefficients import atan_ratio, norm3, sinc, versinc2
+from .coefficients import atan_ratio, norm3, sinc
+from .rotvec import cos_of_norm
 from .vector import normalize4, scaled4
 
 
@@ -36,11 +37,9 @@ def quat_exp(w, x, y, z):
     n = m * r
     e = exp(w)
     k = e * sinc(n)
-    # Below |v| = 1, cos|v| = 1 - |v|^2 versinc2(|v|), a function of |v|^2: through
-    # the norm alone autodiff has no second derivative at v = 0 (see
-    # rotvec.quat_angle_from_rotvec); the subtracted term is below 1/2, no accuracy lost.
-    n2 = x * x + y * y + z * z
-    c = where(n2 < 1.0, 1.0 - n2 * versinc2(n), cos(n))
+    # cos|v| through the norm alone has no second derivative at v = 0; cos_of_norm
+    # takes the series in |v|^2 there (one cosine, not the cosine and a sine).
+    c = cos_of_norm(x * x + y * y + z * z, n)
     return (e * c, k * x, k * y, k * z)
 
 
