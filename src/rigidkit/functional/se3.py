@@ -394,10 +394,8 @@ def _checked(kern, x, trail, what, zero_message):
 def pose_from_dual_quat(dual_quat, *, scalar_first=True):
     """Poses of unit dual quaternions ``q_r + eps q_d``, ``q_d = (0, t) q_r / 2``.
 
-    Stored as ``(q_r, q_d)``, 8 numbers: ``scalar_first=True`` (ours)
-    ``(rw, rx, ry, rz, dw, dx, dy, dz)``, ``False`` ``(rx, ry, rz, rw, dx, dy, dz,
-    dw)`` (scipy's default); Hamilton products. The translation is ``t = 2 vec(q_d
-    q_r*)``. Non-unit input is normalised as by scipy's
+    Stored as ``(q_r, q_d)``, 8 numbers (Hamilton products). The translation is
+    ``t = 2 vec(q_d q_r*)``. Non-unit input is normalised as by scipy's
     ``RigidTransform.from_dual_quat``: both parts divided by ``|q_r|`` and the
     component of ``q_d`` along ``q_r`` dropped, i.e. ``q = q_r / |q_r|`` and ``t =
     2 vec(q_d q_r*) / |q_r|^2``. ``q`` and ``-q`` (all 8 numbers) are one motion.
@@ -405,12 +403,15 @@ def pose_from_dual_quat(dual_quat, *, scalar_first=True):
     Parameters
     ----------
     dual_quat : array_like, shape (..., 8)
+        ``(q_r, q_d)``, each of the two parts in the order of ``scalar_first``.
     scalar_first : bool
+        True (ours): ``(rw, rx, ry, rz, dw, dx, dy, dz)``; False (scipy's
+        default): ``(rx, ry, rz, rw, dx, dy, dz, dw)``.
 
     Returns
     -------
     ndarray, shape (..., 7)
-        Poses ``(w, x, y, z, tx, ty, tz)``.
+        Poses ``(w, x, y, z, tx, ty, tz)``, ``w`` of the sign of ``rw``.
 
     Raises
     ------
@@ -446,14 +447,15 @@ def pose_from_dual_quat(dual_quat, *, scalar_first=True):
 def dual_quat_from_pose(pose, *, scalar_first=True):
     """Unit dual quaternions ``(q, (0, t) q / 2)`` of poses, shape (..., 8).
 
-    The layout of :func:`pose_from_dual_quat` (``scalar_first=False``: both parts
-    scalar last, scipy's default). The quaternion is normalised first.
+    The layout of :func:`pose_from_dual_quat`. The quaternion is normalised first.
 
     Parameters
     ----------
     pose : array_like, shape (..., 7)
         ``(w, x, y, z, tx, ty, tz)``.
     scalar_first : bool
+        True (ours): ``(rw, rx, ry, rz, dw, dx, dy, dz)``; False (scipy's
+        default): both parts scalar last.
 
     Returns
     -------
@@ -475,19 +477,20 @@ def dual_quat_from_pose(pose, *, scalar_first=True):
 def pose_from_pq(pq, *, scalar_first=True):
     """Poses of pose vectors: translation, then quaternion (normalised).
 
-    ``scalar_first=True``: ``(tx, ty, tz, qw, qx, qy, qz)``, pytransform3d's
-    ``pq``; ``False``: ``(tx, ty, tz, qx, qy, qz, qw)``, the TUM trajectory and ROS
-    ``Pose`` order. Hamilton quaternions; the motion is ``p -> R p + t``.
+    Hamilton quaternions; the motion is ``p -> R p + t``.
 
     Parameters
     ----------
     pq : array_like, shape (..., 7)
+        The translation ``t``, then the quaternion in the order of ``scalar_first``.
     scalar_first : bool
+        True: ``(tx, ty, tz, qw, qx, qy, qz)``, pytransform3d's ``pq``; False:
+        ``(tx, ty, tz, qx, qy, qz, qw)``, the TUM trajectory and ROS ``Pose`` order.
 
     Returns
     -------
     ndarray, shape (..., 7)
-        Poses ``(w, x, y, z, tx, ty, tz)``.
+        Poses ``(w, x, y, z, tx, ty, tz)``, the quaternion moved first.
 
     Raises
     ------
@@ -512,14 +515,15 @@ def pose_from_pq(pq, *, scalar_first=True):
 def pq_from_pose(pose, *, scalar_first=True):
     """Pose vectors ``(tx, ty, tz, qw, qx, qy, qz)`` of poses (the quaternion normalised).
 
-    ``scalar_first=False`` gives TUM/ROS ``(tx, ty, tz, qx, qy, qz, qw)``; the
-    inverse of :func:`pose_from_pq`.
+    The inverse of :func:`pose_from_pq`.
 
     Parameters
     ----------
     pose : array_like, shape (..., 7)
         ``(w, x, y, z, tx, ty, tz)``.
     scalar_first : bool
+        True: pytransform3d's ``pq`` (the order of the summary line); False:
+        TUM/ROS ``(tx, ty, tz, qx, qy, qz, qw)``.
 
     Returns
     -------
