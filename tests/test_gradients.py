@@ -95,6 +95,28 @@ def real_quaternions(rng):
     return q, ("random", "random", "zero", "tiny", "near_pi", "pi")
 
 
+def hamilton(a, b):
+    """Hamilton products ``a b`` of quaternions ``(w, x, y, z)`` (..., 4), by hand."""
+    aw, av, bw, bv = a[..., :1], a[..., 1:], b[..., :1], b[..., 1:]
+    w = aw * bw - np.sum(av * bv, axis=-1, keepdims=True)
+    return np.concatenate([w, aw * bv + bw * av + np.cross(av, bv)], axis=-1)
+
+
+def dual_quats(rng):
+    """``(q, (0, t) q / 2)`` of rotations of each kind and random ``t``, scaled by
+    0.7..1.4 (non-unit input, which ``from_dual_quat`` normalises)."""
+    q = quats(rng)
+    t = np.concatenate([np.zeros((len(q), 1)), rng.standard_normal((len(q), 3))], -1)
+    return np.concatenate([q, 0.5 * hamilton(t, q)], -1) * rng.uniform(0.7, 1.4, (6, 1))
+
+
+def pose_pairs(rng):
+    """Poses ``(q1, t1, q2, t2)`` whose relative rotation ``q1* q2`` is of each kind."""
+    q1, rel = quats(rng, ("random",) * len(KINDS)), quats(rng)
+    t1, t2 = rng.standard_normal((2, len(KINDS), 3))
+    return np.concatenate([q1, t1, hamilton(q1, rel), t2], -1)
+
+
 def planar_twists(rng):
     """``(vx, vy, omega)`` with ``|omega|`` of each kind."""
     omega = np.linalg.norm(rotvecs(rng), axis=-1)[:, None]
@@ -271,6 +293,34 @@ OPS = [
         "Quaternion * Quaternion",
         lambda x: (rk.Quaternion(x[..., :4]) * rk.Quaternion(x[..., 4:]))._q,
         lambda rng: rng.standard_normal((4, 8)),
+    ),
+    # SE(3): other software's formats, the inverse action, a distance
+    Op(
+        "Transform.apply(inverse=True)",
+        lambda x: T(R.from_quat(x[..., :4]), x[..., 4:7]).apply(x[..., 7:], inverse=True),
+        lambda rng: with_random(quats(rng), rng, 6),
+    ),
+    Op("Transform.from_dual_quat", lambda x: T.from_dual_quat(x).as_matrix(), dual_quats),
+    # (pq and dual quaternions are polynomial in q and t after the normalisation)
+    Op(
+        "Transform.from_pq(xyzw).as_dual_quat",
+        lambda x: T.from_pq(x, scalar_first=False).as_dual_quat(),
+        lambda rng: np.concatenate(
+            [rng.standard_normal((6, 3)), np.roll(quats(rng), -1, axis=-1)], -1
+        ),
+    ),
+    # theta^2 is smooth at a relative rotation of 0 (the distance too, t1 != t2);
+    # theta is |w|-like at pi.
+    Op(
+        "Transform.distance_to",
+        lambda x: T(R.from_quat(x[..., :4]), x[..., 4:7]).distance_to(
+            T(R.from_quat(x[..., 7:11]), x[..., 11:]),
+            rotation_weight=0.7,
+            translation_weight=1.3,
+        ),
+        pose_pairs,
+        PI,
+        NEAR,
     ),
 ]
 
