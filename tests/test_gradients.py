@@ -117,6 +117,13 @@ def pose_pairs(rng):
     return np.concatenate([q1, t1, hamilton(q1, rel), t2], -1)
 
 
+def distance_to(x):
+    """``T1.distance_to(T2)`` of ``x = (q1, t1, q2, t2)``, weights 0.7 and 1.3."""
+    T1 = T(R.from_quat(x[..., :4]), x[..., 4:7])
+    T2 = T(R.from_quat(x[..., 7:11]), x[..., 11:])
+    return T1.distance_to(T2, rotation_weight=0.7, translation_weight=1.3)
+
+
 def planar_twists(rng):
     """``(vx, vy, omega)`` with ``|omega|`` of each kind."""
     omega = np.linalg.norm(rotvecs(rng), axis=-1)[:, None]
@@ -310,17 +317,15 @@ OPS = [
         ),
     ),
     # theta^2 is smooth at a relative rotation of 0 (the distance too, t1 != t2);
-    # theta is |w|-like at pi.
+    # theta is |w|-like at pi. Second derivatives at 0 and 1e-8 (rounded to 0 in
+    # float32) are wrong where the relative rotation is exactly 0: the known bug of
+    # test_distance_hessian_at_equal_rotations; checked here once it is fixed.
     Op(
         "Transform.distance_to",
-        lambda x: T(R.from_quat(x[..., :4]), x[..., 4:7]).distance_to(
-            T(R.from_quat(x[..., 7:11]), x[..., 11:]),
-            rotation_weight=0.7,
-            translation_weight=1.3,
-        ),
+        distance_to,
         pose_pairs,
         PI,
-        NEAR,
+        NEAR | {"zero", "tiny"},
     ),
 ]
 
@@ -589,3 +594,16 @@ def test_cos_of_norm_across_its_threshold():
         bound = 2.3e-16 * (1.0 + rounded_norm * n * np.tan(n))
         i = int(np.argmax(err / bound))
         assert err[i] <= bound[i], f"{label}: rel. error {err[i]:.3g} at n = {n[i]!r}"
+
+
+@pytest.mark.xfail(strict=True, reason="pose_distance: d(theta)/dq = 0 at theta = 0")
+def test_distance_hessian_at_equal_rotations(torch):
+    """Where the two rotations are bit-equal (``t1 != t2``) the distance is smooth
+    (``theta^2`` is), but ``theta = 2 atan2(norm3(v), w)`` has the subgradient 0 at
+    ``v = 0``, so autodiff drops the rotation block of the Hessian (all zeros). The
+    reference: second differences of the NumPy path."""
+    x0 = np.array([[1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 2.0, 3.0]])
+    op = Op("distance_to(equal rotations)", distance_to, None)
+    c = np.ones(1)
+    _, H = torch_derivatives(torch, op, x0, c, torch.float64)
+    np.testing.assert_allclose(H[0], fd_hessian(op, x0, c)[0], atol=1e-5)
