@@ -52,6 +52,10 @@ def _inputs(rng):
         "xi2": rng.uniform(-1.0, 1.0, (B, 3)),
         "xi7": rng.uniform(-0.5, 0.5, (B, 7)),
         "t": rng.uniform(0.1, 0.9, (B,)),
+        # (drawn last: the inputs above keep their values)
+        "pq": np.concatenate([rng.standard_normal((B, 3)), 1.5 * _unit(rng, (B,))], -1),
+        "pose": np.concatenate([_unit(rng, (B,)), rng.standard_normal((B, 3))], -1),
+        "pose2": np.concatenate([_unit(rng, (B,)), rng.standard_normal((B, 3))], -1),
     }
 
 
@@ -123,6 +127,38 @@ OPS = [
     ),
     ("Transform.adjoint", lambda xi: T_.exp(xi).adjoint(), "xi", True),
     ("Transform.translation", lambda xi: T_.exp(xi).translation, "xi", True),
+    # other software's formats: each op one constructor and one other representation
+    (
+        "Transform.from_dual_quat.as_pq",
+        lambda xi: T_.from_dual_quat(1.3 * T_.exp(xi).as_dual_quat()).as_pq(),
+        "xi",
+        True,
+    ),
+    (
+        "Transform.from_exp_coords.as_dual_quat(xyzw)",
+        lambda xi: T_.from_exp_coords(xi).as_dual_quat(scalar_first=False),
+        "xi",
+        True,
+    ),
+    (
+        "Transform.from_pq(xyzw).as_exp_coords",
+        lambda pq: T_.from_pq(pq, scalar_first=False).as_exp_coords(),
+        "pq",
+        True,
+    ),
+    (
+        "Transform.apply(inverse=True)",
+        lambda xi, v: T_.exp(xi).apply(v, inverse=True),
+        "xi v",
+        True,
+    ),
+    (
+        "Transform.distance_to",
+        lambda xi, q: T_.exp(xi).distance_to(T_(R_.from_quat(q)), translation_weight=2.0),
+        "xi q",
+        True,
+    ),
+    ("se3.pose_distance", se3.pose_distance, "pose pose2", True),
     # so3 / se3
     ("so3.hat", so3.hat, "w", True),
     ("so3.vee", lambda M: so3.vee(M), "M", True),
@@ -384,6 +420,7 @@ COMPILED = [
     "Rotation.as_euler.ZYX",
     "Rotation.compose",
     "Transform.apply",
+    "Transform.from_dual_quat.as_pq",  # a validity output read on the host eagerly
     "so3.log",
     "se3.exp",
 ]
