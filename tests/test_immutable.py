@@ -212,6 +212,20 @@ def constructors():
     yield "Transform(translation=)", lambda a: rk.Transform(translation=a), q[:, :3]
     yield "Transform.from_matrix", lambda a: rk.Transform.from_matrix(a), M4
     yield "Transform.exp", lambda a: rk.Transform.exp(a), rng.standard_normal((3, 6))
+    T = rk.Transform.from_matrix(M4)
+    yield (
+        "Transform.from_dual_quat",
+        lambda a: rk.Transform.from_dual_quat(a),
+        T.as_dual_quat(),
+    )
+    yield "Transform.from_exp_coords", lambda a: rk.Transform.from_exp_coords(a), T.log()
+    yield "Transform.from_pq", lambda a: rk.Transform.from_pq(a), T.as_pq()
+    yield "Rotation.from_6d", lambda a: rk.Rotation.from_6d(a), R.as_6d()
+    yield (
+        "Rotation.from_davenport(angles)",
+        lambda a: rk.Rotation.from_davenport(np.eye(3)[[2, 1, 2]], "e", a),
+        R.as_euler("zyz"),
+    )
     yield "Rotation2D", lambda a: rk.Rotation2D(a), q[:, :2]
     yield "Transform2D", lambda a: rk.Transform2D(translation=a), q[:, :2]
     yield "Similarity", lambda a: rk.Similarity(translation=a), q[:, :3]

@@ -88,6 +88,29 @@ def cases():
         lambda p, d, h, t: rk.Transform.from_screw(p, d, h, t),
         [v3, rng.standard_normal((N, 3)), rng.uniform(0.1, 1, N), ang],
     )
+    yield "Rotation.from_6d", lambda a: rk.Rotation.from_6d(a), [R.as_6d()]
+    yield (
+        "Rotation.from_davenport(angles)",
+        lambda t: rk.Rotation.from_davenport(np.eye(3)[[2, 1, 2]], "e", t),
+        [v3],
+    )
+    yield (
+        "Transform.from_dual_quat",
+        lambda d: rk.Transform.from_dual_quat(d),
+        [T.as_dual_quat()],
+    )
+    yield (
+        "Transform.from_dual_quat(xyzw)",
+        lambda d: rk.Transform.from_dual_quat(d, scalar_first=False),
+        [T.as_dual_quat(scalar_first=False)],
+    )
+    yield "Transform.from_exp_coords", lambda c: rk.Transform.from_exp_coords(c), [T.log()]
+    yield "Transform.from_pq", lambda p: rk.Transform.from_pq(p), [T.as_pq()]
+    yield (
+        "Transform.from_pq(xyzw)",
+        lambda p: rk.Transform.from_pq(p, scalar_first=False),
+        [T.as_pq(scalar_first=False)],
+    )
     yield "Rotation2D", lambda c: rk.Rotation2D(c), [np.array(R2._data)]
     yield "Rotation2D.from_angle", lambda t: rk.Rotation2D.from_angle(t), [ang]
     yield "Rotation2D.exp", lambda t: rk.Rotation2D.exp(t), [ang[:, None]]
