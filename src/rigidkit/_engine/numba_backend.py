@@ -170,14 +170,23 @@ def _size(shape) -> int:
 
 
 def _has_star_call(fn) -> bool:
-    """True if ``fn`` calls something with ``*args`` (numba cannot inline that)."""
-    import ast
+    """True if ``fn`` calls something with ``*args`` (numba cannot inline that).
 
-    tree = ast.parse(function_source(fn))
-    return any(
-        isinstance(node, ast.Call) and any(isinstance(x, ast.Starred) for x in node.args)
-        for node in ast.walk(tree)
-    )
+    Read from the bytecode (``CALL_FUNCTION_EX``), not by ``ast.parse``: this runs
+    on the background thread, and on CPython 3.11 before 3.11.8 two threads that
+    build ``ast`` objects at once can make either raise ``SystemError: AST
+    constructor recursion depth mismatch`` (CPython gh-106905), in the user's
+    thread as much as in ours.
+    """
+    import dis
+
+    def star(code) -> bool:
+        ops = {i.opname for i in dis.get_instructions(code)}
+        return "CALL_FUNCTION_EX" in ops or any(
+            star(c) for c in code.co_consts if hasattr(c, "co_code")
+        )
+
+    return star(fn.__code__)
 
 
 def module_source(kernel, bcast=()) -> str:
