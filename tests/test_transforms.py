@@ -103,6 +103,45 @@ OPS = [
     ("Rotation.plus", lambda q, w: R_.from_quat(q).plus(w).as_quat(), "q w", True),
     ("Rotation.minus", lambda q, p: R_.from_quat(q).minus(R_.from_quat(p)), "q q2", True),
     ("Rotation.pow", lambda q, t: (R_.from_quat(q) ** t).as_quat(), "q t", True),
+    ("Rotation.from_6d.as_6d", lambda xi: R_.from_6d(xi).as_6d(), "xi", True),
+    (
+        "Rotation.swing_twist",
+        lambda q: R_.from_quat(q).swing_twist(np.array([0.0, 0.0, 1.0]))[1].as_quat(),
+        "q",
+        True,
+    ),
+    (
+        "Rotation.angle_to",
+        lambda q, p: R_.from_quat(q).angle_to(R_.from_quat(p)),
+        "q q2",
+        True,
+    ),
+    (
+        "Rotation.chordal_distance",
+        lambda q, p: R_.from_quat(q).chordal_distance(R_.from_quat(p)),
+        "q q2",
+        True,
+    ),
+    (
+        "Rotation.from_davenport.as_davenport",
+        lambda a: R_.from_davenport(np.eye(3)[[2, 1, 0]], "i", a).as_davenport(
+            np.eye(3)[[0, 1, 0]], "e"
+        ),
+        "ang",
+        True,
+    ),
+    (
+        "jacobians.compose(left): Ad(X)",
+        lambda q, p: rk.jacobians.compose(R_(q), R_(p), frame="left")[-1],
+        "q q2",
+        True,
+    ),
+    (
+        "jacobians.plus(Rotation)",
+        lambda q, w: rk.jacobians.plus(R_.from_quat(q), w)[2],
+        "q w",
+        True,
+    ),
     (
         "Rotation.approx_equal",
         lambda q: R_.from_quat(q).approx_equal(R_.from_quat(q)),
