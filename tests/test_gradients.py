@@ -317,16 +317,8 @@ OPS = [
         ),
     ),
     # theta^2 is smooth at a relative rotation of 0 (the distance too, t1 != t2);
-    # theta is |w|-like at pi. Second derivatives at 0 and 1e-8 (rounded to 0 in
-    # float32) are wrong where the relative rotation is exactly 0: the known bug of
-    # test_distance_hessian_at_equal_rotations; checked here once it is fixed.
-    Op(
-        "Transform.distance_to",
-        distance_to,
-        pose_pairs,
-        PI,
-        NEAR | {"zero", "tiny"},
-    ),
+    # theta is |w|-like at pi.
+    Op("Transform.distance_to", distance_to, pose_pairs, PI, NEAR),
 ]
 
 
@@ -596,7 +588,6 @@ def test_cos_of_norm_across_its_threshold():
         assert err[i] <= bound[i], f"{label}: rel. error {err[i]:.3g} at n = {n[i]!r}"
 
 
-@pytest.mark.xfail(strict=True, reason="pose_distance: d(theta)/dq = 0 at theta = 0")
 def test_distance_hessian_at_equal_rotations(torch):
     """Where the two rotations are bit-equal (``t1 != t2``) the distance is smooth
     (``theta^2`` is), but ``theta = 2 atan2(norm3(v), w)`` has the subgradient 0 at

@@ -12,8 +12,8 @@ pq                    pytransform3d's pose vector ``(tx, ty, tz, qw, qx, qy, qz)
 """
 
 from .._engine import kernel
-from .coefficients import norm3
-from .quaternion import quat_angle, quat_apply, quat_multiply, quat_normalize
+from .coefficients import atan_ratio, norm3
+from .quaternion import quat_apply, quat_hemisphere, quat_multiply, quat_normalize
 from .se3 import pose_from_twist, twist_from_pose
 
 
@@ -81,10 +81,18 @@ def pose_distance(
     ``theta`` (radians, [0, pi]) is the angle of ``R1^T R2`` (``atan2``-based, so
     exact near 0 and pi) and ``|t2 - t1|`` is the length of the translation
     ``R1^T (t2 - t1)`` of ``T1^-1 T2`` (a rotation keeps lengths); ``a``, ``b`` the
-    (non-negative) weights. Written as nested :func:`norm3`, whose gradient at 0
-    is 0 (a subgradient) rather than NaN, at ``T1 = T2`` and at ``t1 = t2``.
+    (non-negative) weights. ``theta^2`` is taken as ``|2 v atan2(|v|, w) / |v||^2``
+    (:func:`atan_ratio`), a smooth function of the quaternion ``(w, v)``: through
+    ``theta`` itself autodiff would see ``d theta / dv = 0`` at ``v = 0`` (the norm's
+    subgradient) and lose the rotation part of the Hessian where the rotations are
+    equal and the translations not. The root is taken at a safe argument, so the
+    gradient at ``T1 = T2`` is 0 (a subgradient), not NaN.
     """
     rw, rx, ry, rz = quat_multiply(w1, -x1, -y1, -z1, w2, x2, y2, z2)
-    theta = quat_angle(rw, rx, ry, rz)
-    d = norm3(tx2 - tx1, ty2 - ty1, tz2 - tz1)
-    return (norm3(sqrt(rotation_weight) * theta, sqrt(translation_weight) * d, 0.0),)
+    rw, rx, ry, rz = quat_hemisphere(rw, rx, ry, rz)
+    k = 2.0 * atan_ratio(norm3(rx, ry, rz), rw)
+    theta2 = k * k * (rx * rx + ry * ry + rz * rz)
+    dx, dy, dz = tx2 - tx1, ty2 - ty1, tz2 - tz1
+    s = rotation_weight * theta2 + translation_weight * (dx * dx + dy * dy + dz * dz)
+    pos = s > 0.0
+    return (where(pos, sqrt(where(pos, s, 1.0)), 0.0),)
