@@ -288,3 +288,101 @@ def _attach(group, build):
         out.dask = new.dask
         out._name = new.name
         group.names.add(new.name)
+
+
+# -- host-side algorithms over chunks -------------------------------------------------
+
+
+def _run_batched(fn, relabel, nin, nb, *blocks):
+    """One chunk of :func:`map_batched`: ``fn`` on NumPy blocks, errors relabelled."""
+    from ..errors import RigidkitError
+
+    arrays, offsets = blocks[:nin], blocks[nin : nin + nb]
+    try:
+        res = fn(*arrays)
+    except RigidkitError as err:
+        if not err.index or relabel is None:
+            raise
+        glob = tuple(int(off[i]) for off, i in zip(offsets, err.index))
+        raise relabel(err, glob + tuple(err.index[len(glob) :])) from None
+    return res if isinstance(res, tuple) else (res,)
+
+
+def _pick(block, k):
+    return block[k]
+
+
+def map_batched(fn, arrays, trails, relabel=None, outputs=None):
+    """``fn(*numpy_blocks)`` per chunk of the batch: one independent problem per element.
+
+    For host-side algorithms (an SVD, an eigen-solve, a search) that are not one
+    kernel but solve each batch element on its own. ``arrays`` (Dask, NumPy or
+    ``None``) have leading batch axes, aligned from the right as in NumPy
+    broadcasting, and ``trails[k]`` trailing problem axes, which are made whole
+    (one chunk); batch axes stay chunked. ``fn`` returns one array or a tuple,
+    each with the block's batch shape followed by ``outputs[k] = (trailing shape,
+    dtype)``. An error ``fn`` raises naming an index within the chunk is replaced
+    by ``relabel(err, global_index)`` at compute time (trailing index entries,
+    beyond the batch, are kept). Returns one Dask array per output (a tuple when
+    there are several); nothing is computed.
+
+    Without ``outputs``, ``fn`` first runs on empty NumPy arrays (a leading axis of
+    length 0 added): that raises its static errors (shapes, counts) now, as the
+    NumPy path would, and gives the outputs' trailing shapes and dtypes.
+    """
+    import dask.array as da
+    from dask.array.core import unify_chunks
+
+    nbs = [None if a is None else a.ndim - t for a, t in zip(arrays, trails)]
+    nb = max(n for n in nbs if n is not None)
+    if outputs is None:
+        empty = [None if a is None else np.zeros((0,) + a.shape, a.dtype) for a in arrays]
+        probe = fn(*empty)
+        probe = probe if isinstance(probe, tuple) else (probe,)
+        outputs = [(tuple(r.shape[1 + nb :]), r.dtype) for r in probe]
+    batch = _LETTERS[:nb]
+    pairs, used = [], nb
+    for a, t, nbk in zip(arrays, trails, nbs):
+        if a is None:
+            pairs += [None, None]
+            continue
+        trail = _LETTERS[used : used + t]
+        used += t
+        if not is_dask(a):
+            a = da.asarray(np.asarray(a))
+        if t:
+            a = a.rechunk({a.ndim - 1 - k: -1 for k in range(t)})
+        pairs += [a, batch[nb - nbk :] + trail]
+    chunkss, unified = unify_chunks(*pairs)
+    pairs[::2] = unified
+    offsets = []
+    for letter in batch:
+        chunks = chunkss[letter]
+        offsets += [da.arange(sum(chunks), chunks=(chunks,)), letter]
+    combo = da.blockwise(
+        _run_batched, batch, fn, None, relabel, None, len(arrays), None, nb, None,
+        *pairs, *offsets, concatenate=True, dtype=object,
+        meta=np.empty((0,) * nb, dtype=object), align_arrays=False,
+    )  # fmt: skip
+    results = []
+    for k, (shape, dtype) in enumerate(outputs):
+        trail = _LETTERS[used : used + len(shape)]
+        results.append(
+            da.blockwise(
+                _pick,
+                batch + trail,
+                combo,
+                batch,
+                k,
+                None,
+                new_axes=dict(zip(trail, shape)),
+                dtype=dtype,
+                meta=np.empty((0,) * (nb + len(shape)), dtype=dtype),
+            )  # fmt: skip
+        )
+    return results[0] if len(results) == 1 else tuple(results)
+
+
+def any_dask(*xs) -> bool:
+    """Whether any of ``xs`` is a Dask collection."""
+    return any(type(x) is not np.ndarray and is_dask(x) for x in xs)

@@ -14,7 +14,9 @@ first (weighted centroids) and adds the translation and, optionally, the scale
 Quaternions are Hamilton, scalar first; poses ``(w, x, y, z, tx, ty, tz)`` and
 similarities ``(w, x, y, z, tx, ty, tz, s)``. Written against the array API
 (``linalg.svd`` and ``linalg.det`` of the input's namespace); the degeneracy
-checks read concrete values.
+checks read concrete values. Dask arrays stay lazy: each chunk of the batch is
+solved on its own (the problem axes ``(N, 3)`` made whole, batch axes chunked), and
+a degenerate problem raises at compute time naming the global batch index.
 
 >>> import numpy as np
 >>> b = np.eye(3)
@@ -28,8 +30,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._engine import dask_backend
 from .._engine.namespace import device_of, is_float32, namespace_of
 from .._validate import (
+    _relabel,
     any_true,
     as_float,
     batch_index,
@@ -91,6 +95,31 @@ def _pairs(a, b, weights, what):
     return xp, a, b, w
 
 
+def _lazy(fn, a, b, weights, **kw):
+    """``fn`` over the chunks of Dask input: one independent problem per element."""
+    import dask.array as da
+
+    arrays = [a, b] if weights is None else [a, b, weights]
+    arrays = [x if dask_backend.is_dask(x) else np.asarray(x) for x in arrays]
+    if min(x.ndim for x in arrays[:2]) < 2:  # the NumPy path's shape error, now
+        return fn(*(np.zeros(x.shape, x.dtype) for x in arrays), **kw)
+    shape = np.broadcast_shapes(arrays[0].shape, arrays[1].shape)
+    shapes = [shape, shape, shape[:-1]]
+    arrays = [da.broadcast_to(x, s) for x, s in zip(arrays, shapes)]
+    trails = [2, 2, 1][: len(arrays)]
+    return dask_backend.map_batched(_Solve(fn, kw), arrays, trails, _relabel)
+
+
+class _Solve:
+    """``fn(*blocks, **kw)``, picklable for worker processes (a module-level class)."""
+
+    def __init__(self, fn, kw):
+        self.fn, self.kw = fn, kw
+
+    def __call__(self, *blocks):
+        return self.fn(*blocks, **self.kw)
+
+
 def _zero_check(xp, total, what):
     bad = total <= 0.0
     if any_true(bad):
@@ -146,7 +175,14 @@ def kabsch(a, b, weights=None):
     DegenerateInputError
         Negative weights, or ``H = 0`` (all pairs zero or of zero weight): no
         rotation is singled out.
+
+    Notes
+    -----
+    Dask input stays lazy (chunked along the batch); a degenerate pair set
+    raises at compute time, naming its global batch index.
     """
+    if dask_backend.any_dask(a, b, weights):
+        return _lazy(kabsch, a, b, weights)
     xp, a, b, w = _pairs(a, b, weights, "vectors")
     aw = a if w is None else a * w[..., None]
     h = aw.mT @ b  # sum_i w_i a_i b_i^T
@@ -178,7 +214,14 @@ def umeyama(src, dst, weights=None, *, scale=False):
         Fewer than 3 points, weights that are negative or sum to zero, or points
         (of positive weight) that are coincident or collinear: the rotation about
         their line is then undetermined.
+
+    Notes
+    -----
+    Dask input stays lazy (chunked along the batch); degenerate points raise
+    at compute time, naming their global batch index.
     """
+    if dask_backend.any_dask(src, dst, weights):
+        return _lazy(umeyama, src, dst, weights, scale=scale)
     xp, x, y, w = _pairs(src, dst, weights, "points")
     n = x.shape[-2]
     if n < 3:
