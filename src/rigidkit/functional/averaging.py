@@ -20,6 +20,14 @@ Written against the array API (namespace of the input; ``linalg.eigh`` of the
 namespace); the Karcher loop tests convergence on concrete values (NumPy-side),
 so it does not trace under ``jax.jit``.
 
+Dask arrays stay lazy: the reduced axes are made whole (one chunk, rechunked) and
+each chunk of the kept batch axes is averaged on its own (one ``map_blocks``-like
+layer; with the default ``axis=None`` the whole batch is one chunk). The Karcher
+loop then tests convergence per chunk (each chunk's mean log below ``tol``, as the
+whole batch's is in NumPy), and the iteration count returned is a 0-d Dask array
+(the most steps of any chunk). Bad input raises at compute time, naming the
+global batch index.
+
 >>> import numpy as np
 >>> c, s = np.cos(0.1), np.sin(0.1)
 >>> mean, steps = quat_mean([[c, 0.0, 0.0, s], [-c, 0.0, 0.0, s]])  # +-0.2 rad about z
@@ -29,14 +37,16 @@ array([1., 0., 0., 0.])
 
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 
 import numpy as np
 
+from .._engine import dask_backend
 from .._engine import numba_backend as _numba_backend
 from .._engine.namespace import device_of, is_float32, namespace_of
-from .._validate import any_true, batch_index, finite_array, where_text
+from .._validate import _relabel, any_true, batch_index, finite_array, where_text
 from ..errors import ConvergenceWarning, DegenerateInputError
 from ..kernels import quaternion as _kq
 from ..kernels import rotvec as _krv
@@ -362,6 +372,8 @@ def quat_mean_unchecked(
 
     The weights are still validated. :meth:`rigidkit.Rotation.mean` calls this.
     """
+    if dask_backend.any_dask(q, weights):
+        return _lazy_mean(quat_mean_unchecked, q, weights, axis, method, tol, max_iter)
     xp = namespace_of(q)
     g, w, total = _grouped_weighted(xp, q, weights, axis, "rotations")
     if g.shape[-2] == 1 and method in ("chordal", "geodesic"):
@@ -393,6 +405,8 @@ def pose_mean_unchecked(
     p, weights=None, *, method="chordal", axis=None, tol=None, max_iter=100
 ):
     """:func:`pose_mean` of poses with unit quaternions, finite (not checked)."""
+    if dask_backend.any_dask(p, weights):
+        return _lazy_mean(pose_mean_unchecked, p, weights, axis, method, tol, max_iter)
     xp = namespace_of(p)
     g, w, total = _grouped_weighted(xp, p, weights, axis, "poses")
     t = _average(xp, g[..., 4:], w, total)
@@ -401,6 +415,49 @@ def pose_mean_unchecked(
     return xp.concat(
         [_kq.quat_canonical(mean[..., :4]), mean[..., 4:]], axis=-1
     ), iterations
+
+
+def _lazy_mean(fn, x, weights, axis, method, tol, max_iter):
+    """``fn`` on Dask input: kept batch axes chunked, reduced ones made whole."""
+    import dask.array as da
+
+    x = x if dask_backend.is_dask(x) else da.asarray(np.asarray(x))
+    nbatch = x.ndim - 1
+    axes = reduce_axes(axis, nbatch)
+    keep = [a for a in range(nbatch) if a not in axes]
+    order = tuple(keep) + axes
+    arrays = [da.transpose(x, order + (nbatch,))]
+    if weights is not None:
+        w = weights if dask_backend.is_dask(weights) else np.asarray(weights)
+        arrays.append(da.transpose(da.broadcast_to(w, x.shape[:-1]), order))
+    if method in ("chordal", "geodesic") and math.prod(x.shape[a] for a in axes) == 0:
+        _check_count(np.zeros((0, 4)), "poses" if x.shape[-1] == 7 else "rotations")
+    nk = len(keep)
+    block = functools.partial(
+        _mean_block, fn, dict(method=method, axis=tuple(range(nk, nbatch)), tol=tol,
+                              max_iter=max_iter),
+    )  # fmt: skip
+    relabel = functools.partial(_relabel_transposed, order)
+    mean, its = dask_backend.map_batched(
+        block, arrays, [len(axes) + 1, len(axes)][: len(arrays)], relabel,
+        outputs=[((x.shape[-1],), x.dtype), ((), np.int64)],
+    )  # fmt: skip
+    return mean, its.max()
+
+
+def _mean_block(fn, kw, x, w=None):
+    mean, iterations = fn(x, w, **kw)
+    return mean, np.full(mean.shape[:-1], iterations, dtype=np.int64)
+
+
+def _relabel_transposed(order, err, index):
+    """A chunk's error naming ``index`` of the transposed batch, in the caller's axes."""
+    if len(index) == len(order):  # a whole-batch index (negative weights)
+        orig = [0] * len(order)
+        for i, a in zip(index, order):
+            orig[a] = i
+        index = tuple(orig)
+    return _relabel(err, index)
 
 
 def _average(xp, x, w, total):

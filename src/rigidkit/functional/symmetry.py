@@ -11,7 +11,7 @@ sets equal scipy's (up to order and the sign of each quaternion).
 
 The groups are built NumPy-side (they are constants); ``quat_reduce`` runs on the
 quaternions' array namespace (a matrix product and an ``argmax``), also under
-``jax.jit``.
+``jax.jit``; on Dask arrays lazily, chunk by chunk of the batch.
 
 >>> import numpy as np
 >>> q = quat_group("C4")                         # quarter turns about z
@@ -24,13 +24,15 @@ array([[ 1.        ,  0.        ,  0.        ,  0.        ],
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 
 import numpy as np
 
+from .._engine import dask_backend
 from .._engine.namespace import namespace_of
-from .._validate import as_array
+from .._validate import _relabel, as_array
 from ..errors import RigidkitError
 from ..kernels import quaternion as _kq
 from .davenport import asarray_like
@@ -184,6 +186,7 @@ def quat_reduce(quat, left=None, right=None):
         Indices into ``left`` and ``right`` (0 where that group is None).
 
     Memory: ``k_left * k_right`` numbers per rotation (3600 for ``I`` on both sides).
+    Dask input stays lazy: each chunk of the batch is reduced on its own.
 
     Examples
     --------
@@ -194,6 +197,10 @@ def quat_reduce(quat, left=None, right=None):
     (0.029203673205, 3)
     """
     q = as_array(quat, (4,), "quaternion")
+    if dask_backend.any_dask(q):
+        groups = [None if g is None else np.asarray(g) for g in (left, right)]
+        fn = functools.partial(quat_reduce, left=groups[0], right=groups[1])
+        return dask_backend.map_batched(fn, [q], [1], _relabel)
     xp = namespace_of(q)
     ident = [[1.0, 0.0, 0.0, 0.0]]
     L = asarray_like(ident if left is None else left, q)
