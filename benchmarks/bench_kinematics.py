@@ -117,7 +117,8 @@ def check(peers, rng) -> list:
         t = np.arange(50) * 0.01
         R = rk.Rotation.from_rotvec(np.outer(t, [0.3, -0.2, 0.5]))
         ours = K.angular_velocity_from_samples(R, t, frame="world")
-        theirs = peers.pr.quaternion_gradient(R.as_quat(), dt=0.01)
+        # pytransform3d normalises its input in place: give it a writable copy
+        theirs = peers.pr.quaternion_gradient(np.array(R.as_quat()), dt=0.01)
         err = np.abs(ours - theirs)[1:-1].max()
         if err > 1e-9:
             bad.append(f"pytransform3d quaternion_gradient differs by {err:.3g}")
@@ -227,7 +228,7 @@ def rows(peers, n, rng):
     r = {"rigidkit": partial(K.angular_velocity_from_samples, R, t, frame="world")}
     m = min(n, 20_000)  # pytransform3d loops in Python (~150 us per sample)
     if peers.pr:
-        Q = R[:m].as_quat()
+        Q = np.array(R[:m].as_quat())  # writable: pytransform3d normalises in place
         r["pytransform3d"] = partial(peers.pr.quaternion_gradient, Q, dt=1e-3)
     out["angular_velocity_from_samples"] = (r, {"rigidkit": n, "pytransform3d": m})
     return out
