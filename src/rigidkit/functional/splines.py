@@ -7,7 +7,10 @@ layer maps them to the world frame. Keyframes and control points carry the time
 (knot) axis first, then any batch axes, so one call builds many splines that
 share their times. Written against the array API (namespace of the input);
 knot lookup and the convergence test of the spline solve read concrete values
-(NumPy-side), so these functions do not trace under ``jax.jit``.
+(NumPy-side), so these functions do not trace under ``jax.jit``. Dask keyframes
+stay lazy: the spline solve couples all keyframes, so the time axis is made whole
+(one chunk) and each chunk of the further batch axes is solved on its own
+(:func:`rotation_spline_coefficients`); evaluation gathers segments lazily.
 
 Rotation spline (scipy's ``RotationSpline``): between keyframes ``R_i`` and
 ``R_{i+1}``, ``R(t) = R_i exp(hat(r(t - t_i)))`` with ``r(s) = a s^3 + b s^2 + c s``,
@@ -29,11 +32,13 @@ differencing).
 
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 
 import numpy as np
 
+from .._engine import dask_backend
 from .._engine.namespace import device_of, is_float32, namespace_of
 from ..errors import ConvergenceWarning
 from ..kernels import quaternion as _kq
@@ -129,7 +134,16 @@ def rotation_spline_coefficients(times, quats, *, max_iter=50):
         ``(a, b, c)`` of each segment, ``r(s) = a s^3 + b s^2 + c s``.
     iterations : int
         Newton steps taken (0 for two keyframes).
+
+    Notes
+    -----
+    Dask keyframes stay lazy: the time axis is made whole (one chunk: the solve
+    couples all keyframes) and each chunk of the further batch axes (one spline
+    each) is solved on its own, testing convergence per chunk; ``iterations`` is
+    then a 0-d Dask array (the most steps of any chunk).
     """
+    if dask_backend.any_dask(quats):
+        return _lazy_coefficients(times, quats, max_iter)
     xp = namespace_of(quats)
     n = quats.shape[0]
     theta = _relative_rotvecs(quats)
@@ -199,6 +213,26 @@ def rotation_spline_coefficients(times, quats, *, max_iter=50):
     a = (-2.0 * theta + h * c + h * d) / (h * h * h)
     b = (3.0 * theta - 2.0 * h * c - h * d) / (h * h)
     return xp.stack([a, b, c], axis=-2), iterations
+
+
+def _lazy_coefficients(times, quats, max_iter):
+    import dask.array as da
+
+    block = functools.partial(_coefficients_block, np.asarray(times), max_iter)
+    n = quats.shape[0]
+    coeffs, iterations = dask_backend.map_batched(
+        block, [da.moveaxis(quats, 0, -2)], [2],
+        outputs=[((n - 1, 3, 3), quats.dtype), ((), np.int64)],
+    )  # fmt: skip
+    return da.moveaxis(coeffs, -3, 0), iterations.max()
+
+
+def _coefficients_block(times, max_iter, quats):
+    """One chunk of splines, time axis second to last (as :func:`map_batched` wants)."""
+    coeffs, k = rotation_spline_coefficients(
+        times, np.moveaxis(quats, -2, 0), max_iter=max_iter
+    )
+    return np.moveaxis(coeffs, 0, -3), np.full(quats.shape[:-2], k, dtype=np.int64)
 
 
 def rotation_spline_eval(times, quats, coeffs, query, order):
