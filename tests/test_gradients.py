@@ -35,6 +35,7 @@ import pytest
 from scipy.spatial.transform import Rotation as SciRotation
 
 import rigidkit as rk
+from rigidkit._engine.namespace import namespace_of
 
 KINDS = ("random", "random", "zero", "tiny", "near_pi", "pi")
 H1 = {"near_pi": 1e-7}  # first-difference step by kind (default 1e-6)
@@ -133,6 +134,58 @@ def planar_twists(rng):
 def pure_quaternions(rng):
     """Vector parts of norm random, 0, 1e-8, pi - 1e-5, pi, with a random scalar."""
     return np.concatenate([rng.standard_normal((6, 1)), rotvecs(rng)], -1), KINDS
+
+
+def rotation_pairs(rng):
+    """Quaternions ``(q1, q2)`` whose relative rotation ``q1* q2`` is of each kind."""
+    q1, rel = quats(rng, ("random",) * len(KINDS)), quats(rng)
+    return np.concatenate([q1, hamilton(q1, rel)], -1)
+
+
+def rot6d_points(rng):
+    """The first two matrix columns of rotations of each kind, made general: scaled
+    columns, the second not orthogonal to the first (Gram-Schmidt has work to do)."""
+    M = SciRotation.from_rotvec(rotvecs(rng)).as_matrix()
+    a1 = M[..., 0] * rng.uniform(0.5, 2.0, (len(M), 1))
+    a2 = M[..., 1] * rng.uniform(0.5, 2.0, (len(M), 1)) + 0.4 * a1
+    return np.concatenate([a1, a2], -1)
+
+
+def davenport_axes():
+    """General Davenport axes: ``n1, n2`` and ``n2, n3`` orthogonal, ``n1 . n3 =
+    cos(1.1)`` (neither Euler's proper 0 nor Tait-Bryan's pi/2)."""
+    n2 = np.array([0.36, -0.48, 0.8])
+    n1 = np.cross(n2, [1.0, 0.0, 0.0])
+    n1 /= np.linalg.norm(n1)
+    n3 = math.cos(1.1) * n1 + math.sin(1.1) * np.cross(n2, n1)
+    return np.array([n1, n2, n3])
+
+
+DAVENPORT_AXES = davenport_axes()
+
+
+def davenport_points(order):
+    """Points for ``as_davenport``: the standard kinds, a third angle of exactly 0,
+    and an exact lock: the middle turn maps the first axis onto the last
+    (extrinsic, ``+1.1``) or the last onto the first (intrinsic, ``-1.1``). The
+    middle angles lie inside the returned range, ``[1.1 - pi, 1.1]`` or ``[-1.1,
+    pi - 1.1]``, away from its ends (else the others land on their +-pi cut)."""
+
+    def build(rng):
+        lock, mid = (1.1, -1.5) if order == "e" else (-1.1, 1.5)
+        extra = [[0.3, 0.4, 0.0], [-2.0, mid, 0.0], [0.7, lock, 0.0]]
+        q3 = SciRotation.from_davenport(DAVENPORT_AXES, order, extra)
+        q3 = q3.as_quat(scalar_first=True)
+        return np.concatenate([quats(rng), q3]), (*KINDS, "third0", "third0", "lock")
+
+    return build
+
+
+def swing_twist(x):
+    """``(swing, twist)`` quaternions of ``x = (q, axis)``, one row of 8."""
+    swing, twist = R.from_quat(x[..., :4]).swing_twist(x[..., 4:])
+    xp = namespace_of(x)
+    return xp.concat([swing.as_quat(), twist.as_quat()], axis=-1)
 
 
 # -- the table ---------------------------------------------------------------------------
@@ -319,6 +372,56 @@ OPS = [
     # theta^2 is smooth at a relative rotation of 0 (the distance too, t1 != t2);
     # theta is |w|-like at pi.
     Op("Transform.distance_to", distance_to, pose_pairs, PI, NEAR),
+    # -- added after the rest (earlier entries keep their seeds, 1000 + index) --
+    # 6D: Gram-Schmidt of non-orthogonal, scaled columns (the matrix is smooth at
+    # every rotation; the quaternion would flip sign at pi).
+    Op("Rotation.from_6d", lambda x: R.from_6d(x).as_matrix(), rot6d_points),
+    Op("Rotation.as_6d", lambda x: R.from_quat(x).as_6d(), quat_points),
+    # The twist (w, (v . n) n) / norm, flipped to w >= 0, jumps from angle pi to -pi
+    # where w = 0 (a rotation by pi, v . n != 0): both quaternions change sign there,
+    # and 1e-5 from it the second differences cross it.
+    Op(
+        "Rotation.swing_twist",
+        swing_twist,
+        lambda rng: with_random(quats(rng), rng, 3),
+        PI,
+        NEAR,
+    ),
+    # theta of the relative rotation: a cone at 0 (|v|) and at pi (|w|), as Rotation.angle.
+    Op(
+        "rk.geodesic_distance",
+        lambda x: rk.geodesic_distance(R.from_quat(x[..., :4]), R.from_quat(x[..., 4:])),
+        rotation_pairs,
+        CONE,
+        NEAR,
+    ),
+    # 2 sqrt(2) sin(theta / 2) = |R1 - R2|_F: a cone at 0 only; smooth at pi (its
+    # maximum), where it is |v| / |q| of the relative rotation.
+    Op(
+        "rk.chordal_distance",
+        lambda x: rk.chordal_distance(R.from_quat(x[..., :4]), R.from_quat(x[..., 4:])),
+        rotation_pairs,
+        {"zero", "tiny"},
+    ),
+    *[
+        Op(
+            f"Rotation.from_davenport({order})",
+            lambda x, order=order: R.from_davenport(DAVENPORT_AXES, order, x).as_quat(),
+            lambda rng: rotvecs(rng),
+        )
+        for order in ("e", "i")
+    ],
+    # As for as_euler: only the lock is not differentiable (general axes: the
+    # identity is no lock).
+    *[
+        Op(
+            f"Rotation.as_davenport({order})",
+            lambda x, order=order: R.from_quat(x).as_davenport(DAVENPORT_AXES, order),
+            davenport_points(order),
+            {"lock"},
+        )
+        for order in ("e", "i")
+    ],
 ]
 
 
