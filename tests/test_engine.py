@@ -236,6 +236,254 @@ def _euler_params(rng, with_tol):
     return params + (euler.lock_tolerance(np.float64),) if with_tol else params
 
 
+def _f32(span):
+    """Whether a sampler is drawing float32 inputs (``sample`` passes span 30)."""
+    return span < 300
+
+
+def _flag(rng):
+    """A random 0/1 static flag (``body``, ``inverse``, ``to_body``): both get drawn."""
+    return int(rng.integers(2))
+
+
+def _qmul(p, q):
+    """Hamilton products of (n, 4) arrays, written out (the samplers' own)."""
+    w1, x1, y1, z1 = p.T
+    w2, x2, y2, z2 = q.T
+    return np.stack(
+        [
+            w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+            w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+            w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+            w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
+        ],
+        axis=-1,
+    )
+
+
+def _axis_quat(axis, angle):
+    return np.concatenate(
+        [np.cos(angle / 2)[:, None], np.sin(angle / 2)[:, None] * axis], -1
+    )
+
+
+def _davenport_axes(rng, n):
+    """Unit ``n1, n2, n3``, ``n2`` orthogonal to both; ``n1``, ``n3`` at any angle.
+
+    The first rows are Euler axes: ``zyx`` (Tait-Bryan), ``xyx`` (proper),
+    ``n3 = -n1``; then general axes with ``n3 = cos(phi) n1 + sin(phi) n1 x n2``.
+    """
+    a = _unit(rng, n, 3)
+    b = np.cross(a, rng.standard_normal((n, 3)))
+    b /= np.linalg.norm(b, axis=-1, keepdims=True)
+    phi = rng.uniform(-math.pi, math.pi, n)
+    c = np.cos(phi)[:, None] * a + np.sin(phi)[:, None] * np.cross(a, b)
+    e = np.eye(3)
+    euler_like = [(e[2], e[1], e[0]), (e[0], e[1], e[0]), (e[0], e[1], -e[0])]
+    for i, (x, y, z) in enumerate(euler_like[:n]):
+        a[i], b[i], c[i] = x, y, z
+    return a, b, c
+
+
+def _davenport_quats(rng, n, reverse):
+    """Unit quaternions of Davenport angles whose middle angle is >= 0.3 from the lock.
+
+    The lock is at ``t2 = lam (mod pi)``, ``lam`` the angle from the first axis of
+    the product to the last about ``-n2`` (kernels/davenport.py); away from it the
+    angles are well conditioned, so bindings agree to rounding.
+    """
+    a, b, c = _davenport_axes(rng, n)
+    f, p = (c, a) if reverse else (a, c)
+    lam = np.arctan2(np.sum(p * np.cross(f, b), -1), np.sum(p * f, -1))
+    t1, t3 = rng.uniform(-math.pi, math.pi, (2, n))
+    t2 = lam + math.pi / 2 + rng.uniform(-math.pi / 2 + 0.3, math.pi / 2 - 0.3, n)
+    q1, q2, q3 = _axis_quat(a, t1), _axis_quat(b, t2), _axis_quat(c, t3)
+    q = _qmul(_qmul(q3, q2), q1) if reverse else _qmul(_qmul(q1, q2), q3)
+    return [q, a, b, c]
+
+
+def _davenport_params(rng, span, with_tol):
+    """One extrinsic sequence in radians or one intrinsic in degrees, as functional
+    davenport passes them: ``(reverse, scale[, tol])``."""
+    from rigidkit.functional import davenport, euler
+
+    reverse = _flag(rng)
+    if with_tol:  # angles out: radians both (the float32 test compares mod 2 pi)
+        tol = davenport.LOCK_FACTOR * euler.lock_tolerance(
+            np.float32 if _f32(span) else np.float64
+        )
+        return (reverse, 1.0, tol)
+    return (reverse, 1.0 if reverse else math.pi / 180.0)
+
+
+def _quat_from_davenport(rng, n, span):
+    params = _davenport_params(rng, span, False)
+    angles = rng.uniform(-math.pi, math.pi, (n, 3)) / params[1]
+    return params, [*_davenport_axes(rng, n), angles]
+
+
+def _davenport_from_quat(rng, n, span):
+    params = _davenport_params(rng, span, True)
+    return params, _davenport_quats(rng, n, params[0])
+
+
+def _two_vectors(rng, n, span):
+    """Nonzero vector pairs: exactly antiparallel (the half-turn branch) and parallel
+    first, then pairs at most 150 degrees apart (the shortest arc's axis is ill
+    conditioned as the angle nears 180 degrees: the bindings' 40-digit and float32
+    references would differ from the float64 loop by more than rounding)."""
+    u = _vectors(rng, n)
+    v = _vectors(rng, n)
+    cos = np.sum(u * v, -1) / (np.linalg.norm(u, axis=-1) * np.linalg.norm(v, axis=-1))
+    v[cos < -0.85] *= -1.0
+    specials = [
+        (u[0], -2.5 * u[0]),
+        (u[1], 3.0 * u[1]),
+        (np.array([0, 0, 1.0]), -np.array([0, 0, 1.0])),
+    ]
+    for i, (x, y) in enumerate(specials[:n]):
+        u[i], v[i] = x, y
+    e = 64.0 * float(np.finfo(np.float32 if _f32(span) else np.float64).eps)
+    return (0.5 * e * e,), [u, v]  # tiny: alignment._half_turn_tiny
+
+
+def _rotations(rng, n):
+    """Exact-to-rounding rotation matrices (n, 3, 3) of uniform random rotations."""
+    q = _unit(rng, n, 4)
+    w, x, y, z = q.T
+    return np.stack(
+        [
+            1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+            2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+            2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y),
+        ],
+        axis=-1,
+    ).reshape(n, 3, 3)  # fmt: skip
+
+
+def _hat(w):
+    z = np.zeros(len(w))
+    return np.stack(
+        [z, -w[:, 2], w[:, 1], w[:, 2], z, -w[:, 0], -w[:, 1], w[:, 0], z], -1
+    ).reshape(-1, 3, 3)
+
+
+def _homogeneous(rng, n):
+    t = np.zeros((n, 4, 4))
+    t[:, :3, :3] = _rotations(rng, n)
+    t[:, :3, 3] = rng.standard_normal((n, 3))
+    t[:, 3, 3] = 1.0
+    return t
+
+
+def _twist_hat(v):
+    h = np.zeros((len(v), 4, 4))
+    h[:, :3, :3] = _hat(v[:, 3:])
+    h[:, :3, 3] = v[:, :3]
+    return h
+
+
+def _homogeneous_2d(rng, n):
+    a = rng.uniform(-math.pi, math.pi, n)
+    t = np.zeros((n, 3, 3))
+    t[:, 0, 0] = t[:, 1, 1] = np.cos(a)
+    t[:, 1, 0] = np.sin(a)
+    t[:, 0, 1] = -t[:, 1, 0]
+    t[:, :2, 2] = rng.standard_normal((n, 2))
+    t[:, 2, 2] = 1.0
+    return t
+
+
+def _twist_hat_2d(v):
+    h = np.zeros((len(v), 3, 3))
+    h[:, 0, 1] = -v[:, 2]
+    h[:, 1, 0] = v[:, 2]
+    h[:, :2, 2] = v[:, :2]
+    return h
+
+
+def _poses_2d(rng, n):
+    a = rng.uniform(-math.pi, math.pi, n)
+    return np.stack([np.cos(a), np.sin(a), *rng.standard_normal((2, n))], -1)
+
+
+def _steps(rng, n):
+    """Step lengths from 1e-4 to 1 (rates are O(1): increments up to a few radians)."""
+    return 10.0 ** rng.uniform(-4, 0, n)
+
+
+def _euler_rate_params(rng):
+    """``(e1, e2, parity, proper, reverse, body, scale)`` as euler_rates passes them,
+    for Tait-Bryan ``ZYX`` (intrinsic) or proper ``zxz`` (extrinsic), world or body
+    frame, radians or degrees."""
+    from rigidkit import euler
+
+    s = euler.parse_sequence(str(rng.choice(["ZYX", "zxz"])))
+    scale = math.pi / 180.0 if rng.integers(2) else 1.0
+    return s.params + (_flag(rng), scale)
+
+
+def _euler_rate_angles(rng, n, params):
+    """Angles (in the params' unit) with the middle one >= 0.3 rad from gimbal lock
+    (``E^-1`` grows as ``1 / sin`` of that distance)."""
+    proper, scale = params[3], params[-1]
+    a = rng.uniform(-math.pi, math.pi, (n, 3))
+    if proper:
+        a[:, 1] = rng.choice([-1.0, 1.0], n) * rng.uniform(0.3, math.pi - 0.3, n)
+    else:
+        a[:, 1] = rng.uniform(-math.pi / 2 + 0.3, math.pi / 2 - 0.3, n)
+    return a / scale
+
+
+def _euler_rates(nvec):
+    """Sampler of a kinematics_euler kernel: angles, then ``nvec`` O(1) vectors."""
+
+    def draw(rng, n, span):
+        params = _euler_rate_params(rng)
+        vecs = [rng.standard_normal((n, 3)) for _ in range(nvec)]
+        return params, [_euler_rate_angles(rng, n, params), *vecs]
+
+    return draw
+
+
+def _kin(draw):
+    """Sampler of a kernel with one 0/1 flag: ``draw(rng, n)`` gives the arrays."""
+    return lambda rng, n, span: ((_flag(rng),), draw(rng, n))
+
+
+def _matrix_rate(rng, n):
+    r = _rotations(rng, n)
+    return [r, _hat(rng.standard_normal((n, 3))) @ r]
+
+
+def _matrix_accel(rng, n):
+    """Rotations and second derivatives ``(hat(a) + hat(w)^2) R``."""
+    r = _rotations(rng, n)
+    w, a = rng.standard_normal((2, n, 3))
+    return [r, (_hat(a) + _hat(w) @ _hat(w)) @ r]
+
+
+def _homogeneous_rate(rng, n):
+    t = _homogeneous(rng, n)
+    return [t, _twist_hat(rng.standard_normal((n, 6))) @ t]
+
+
+def _homogeneous_rate_2d(rng, n):
+    t = _homogeneous_2d(rng, n)
+    return [t, _twist_hat_2d(rng.standard_normal((n, 3))) @ t]
+
+
+def _quat_rate(rng, n):
+    """Quaternions of any scale and their rates (rotation plus a scale rate)."""
+    q = _unit(rng, n, 4) * 10.0 ** rng.uniform(-3, 3, (n, 1))
+    w = np.concatenate([np.zeros((n, 1)), rng.standard_normal((n, 3))], -1)
+    return [q, 0.5 * _qmul(w, q) + rng.standard_normal((n, 1)) * q]
+
+
+def _normal(rng, n, *shapes):
+    return [rng.standard_normal((n,) + s) for s in shapes]
+
+
 #: Samplers of kernels with static parameters: (rng, n, span) -> (params, arrays).
 PARAM_SAMPLERS = {
     "euler.quat_from_euler": lambda rng, n, span: (
@@ -249,6 +497,70 @@ PARAM_SAMPLERS = {
     "pose_formats.pose_distance": lambda rng, n, span: (
         (2.0, 0.5),  # rotation_weight, translation_weight
         [*_pose_pair(rng, n)],
+    ),
+    # Davenport angles: one extrinsic sequence (radians) or one intrinsic (degrees).
+    "davenport.quat_from_davenport": _quat_from_davenport,
+    "davenport.davenport_from_quat": _davenport_from_quat,
+    "geodesic.quat_from_two_vectors": _two_vectors,
+    # Moving frames, world (body=0) or body (1) velocities; O(1) rates.
+    "kinematics.omega_from_matrix_derivative": _kin(_matrix_rate),
+    "kinematics.alpha_from_matrix_second_derivative": _kin(_matrix_accel),
+    "kinematics.matrix_derivative_from_omega": _kin(
+        lambda rng, n: [_rotations(rng, n), *_normal(rng, n, (3,))]
+    ),
+    "kinematics.matrix_second_derivative": _kin(
+        lambda rng, n: [_rotations(rng, n), *_normal(rng, n, (3,), (3,))]
+    ),
+    "kinematics.matrix_derivative_from_twist": _kin(
+        lambda rng, n: [_homogeneous(rng, n), *_normal(rng, n, (6,))]
+    ),
+    "kinematics.matrix_second_derivative_from_twist": _kin(
+        lambda rng, n: [_homogeneous(rng, n), *_normal(rng, n, (6,), (6,))]
+    ),
+    "kinematics.twist_from_matrix_derivative": _kin(_homogeneous_rate),
+    "kinematics.twist_change_frame": _kin(  # inverse=0: body to world, 1: back
+        lambda rng, n: [_homogeneous(rng, n), *_normal(rng, n, (6,))]
+    ),
+    "kinematics.quat_derivative": _kin(
+        lambda rng, n: [_unit(rng, n, 4), *_normal(rng, n, (3,))]
+    ),
+    "kinematics.quat_second_derivative": _kin(
+        lambda rng, n: [_unit(rng, n, 4), *_normal(rng, n, (3,), (3,))]
+    ),
+    "kinematics.omega_from_quat_derivative": _kin(_quat_rate),
+    # Euler-rate kinematics of ZYX or zxz, the middle angle away from gimbal lock.
+    "kinematics_euler.rate_matrix_from_euler": _euler_rates(0),
+    "kinematics_euler.rate_matrix_inverse_from_euler": _euler_rates(0),
+    "kinematics_euler.rate_matrix_derivative_from_euler": _euler_rates(1),
+    "kinematics_euler.omega_from_euler_rates": _euler_rates(1),
+    "kinematics_euler.euler_rates_from_omega": _euler_rates(1),
+    "kinematics_euler.alpha_from_euler_accelerations": _euler_rates(2),
+    "kinematics_euler.euler_accelerations_from_alpha": _euler_rates(2),
+    # Integration steps: rates at start, middle and end, steps of 1e-4 ... 1.
+    "kinematics_integration.so3_chain": _kin(
+        lambda rng, n: [_unit(rng, n, 4), _unit(rng, n, 4)]
+    ),
+    "kinematics_integration.se3_chain": _kin(
+        lambda rng, n: [_poses(rng, n, 0), _poses(rng, n, 0)]
+    ),
+    "kinematics_integration.so3_increment_rk4": _kin(
+        lambda rng, n: [*_normal(rng, n, (3,), (3,), (3,)), _steps(rng, n)]
+    ),
+    "kinematics_integration.se3_increment_rk4": _kin(
+        lambda rng, n: [*_normal(rng, n, (6,), (6,), (6,)), _steps(rng, n)]
+    ),
+    "kinematics_planar.twist_from_matrix_derivative_2d": _kin(_homogeneous_rate_2d),
+    "kinematics_planar.matrix_derivative_from_twist_2d": _kin(
+        lambda rng, n: [_homogeneous_2d(rng, n), *_normal(rng, n, (3,))]
+    ),
+    "kinematics_planar.twist_change_frame_2d": _kin(  # to_body=0: to world, 1: to body
+        lambda rng, n: [_homogeneous_2d(rng, n), *_normal(rng, n, (3,))]
+    ),
+    "kinematics_planar.se2_chain": _kin(
+        lambda rng, n: [_poses_2d(rng, n), _poses_2d(rng, n)]
+    ),
+    "kinematics_planar.se2_increment_rk4": _kin(
+        lambda rng, n: [*_normal(rng, n, (3,), (3,), (3,)), _steps(rng, n)]
     ),
 }
 
@@ -470,7 +782,10 @@ def _mp_eval(e, env, memo):
 
 
 #: Known failures, each reported with a reproduction; strict, so a fix shows up.
-SYMPY_XFAIL: dict[str, str] = {}
+SYMPY_XFAIL: dict[str, str] = {
+    "geodesic.quat_from_two_vectors": "the expression over symbols contains oo (all four "
+    "outputs; mpmath: 'cannot create mpf from oo'); over Floats it agrees with numba",
+}
 # Compositions of kernels that are each checked here on their own: their symbolic
 # expressions (exp of t times a log, nested) take SymPy over ten minutes to build.
 SYMPY_SKIP = {
@@ -481,6 +796,10 @@ SYMPY_SKIP = {
     "geodesic.quat_power": "nested exp(t log) expression: SymPy runs for minutes",
     "rot6d.quat_from_rot6d": "Gram-Schmidt inside Shepperd's branches: the symbolic "
     "Piecewise compares NaN (its parts, normalize4 and quat_from_matrix, are checked)",
+    "davenport.davenport_from_quat": "reduction to XYX through euler_from_quat over "
+    "symbols: SymPy runs for over 15 s (quat_multiply and euler_from_quat are checked)",
+    "kinematics_integration.se3_increment_rk4": "three nested se(3) brackets, then exp: "
+    "SymPy takes ~3.5 s (so3_increment_rk4 and pose_from_twist are checked)",
 }
 
 
