@@ -466,14 +466,28 @@ COMPILED = [
 
 @pytest.mark.parametrize("name", COMPILED)
 def test_torch_compile_fullgraph(name, data, torch):
-    _, fn, names, _ = next(op for op in OPS if op[0] == name)
+    _compile_one(name, data, torch, "inductor" if name == "se3.exp" else "aot_eager")
+
+
+@pytest.mark.exhaustive
+@pytest.mark.parametrize("name", [op[0] for op in OPS])
+def test_torch_compile_fullgraph_every_op(name, data, torch):
+    """The sweep behind COMPILED: every op of the table, compiled with
+    ``fullgraph=True`` (AOTAutograd, backward included). About 3 s an op, so it
+    is deselected by default: ``pytest -m exhaustive tests/test_transforms.py``."""
+    _compile_one(name, data, torch, "aot_eager")
+
+
+def _compile_one(name, data, torch, backend):
+    _, fn, names, differentiable = next(op for op in OPS if op[0] == name)
     args = _args(data, names)
     torch._dynamo.reset()
-    backend = "inductor" if name == "se3.exp" else "aot_eager"
     compiled = torch.compile(fn, fullgraph=True, backend=backend)
     targs = [torch.as_tensor(a).requires_grad_(True) for a in args]
     out = compiled(*targs)
     _close(out, fn(*args))
+    if not differentiable:
+        return
     out.sum().backward()  # gradients flow through the compiled graph
     assert all(t.grad is not None and bool(torch.isfinite(t.grad).all()) for t in targs)
 

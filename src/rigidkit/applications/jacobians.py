@@ -171,7 +171,7 @@ def compose(X, Y, *, frame="right"):
     """
     _same_kind(X, Y, "compose")
     left = _check_frame(frame)
-    Z = X @ Y
+    Z = X.compose(Y)  # not @: TorchDynamo cannot trace it on objects
     J_X = _ad_inv(Y)
     J_Y = _eye(J_X, X.dof)
     if left:
@@ -368,7 +368,7 @@ def plus(X, tau, *, frame="right"):
     alg = _algebra(type(X), "jacobians.plus's operand")
     left = _check_frame(frame)
     D = type(X).exp(tau)
-    Y = X @ D
+    Y = X.compose(D)
     J_X = _ad_inv(D)
     J_tau = alg.right_jacobian(tau)
     if left:
@@ -411,7 +411,7 @@ def minus(X, Y, *, frame="right"):
     _same_kind(X, Y, "minus")
     alg = _ALGEBRA[type(X)]
     left = _check_frame(frame)
-    tau = (Y.inv() @ X).log()
+    tau = Y.inv().compose(X).log()
     J_X = alg.right_jacobian_inverse(tau)
     J_Y = -alg.left_jacobian_inverse(tau)
     if left:
@@ -452,7 +452,7 @@ def between(X, Y, *, frame="right"):
     """
     _same_kind(X, Y, "between")
     left = _check_frame(frame)
-    Z = X.inv() @ Y
+    Z = X.inv().compose(Y)
     J_X = -_ad_inv(Z)
     J_Y = _eye(J_X, X.dof)
     if left:

@@ -192,17 +192,17 @@ class LieGroup(Group):
         """``X ⊕ tau``: ``X @ exp(tau)`` (right, local) or ``exp(tau) @ X`` (left)."""
         delta = type(self).exp(tau)
         if side == "right":
-            return self @ delta
+            return self.compose(delta)  # not @: TorchDynamo cannot trace it
         if side == "left":
-            return delta @ self
+            return delta.compose(self)
         raise ValueError(f"side must be 'right' or 'left', got {side!r}")
 
     def minus(self, other, *, side="right"):
         """``X ⊖ Y``: ``log(Y^-1 @ X)`` (right) or ``log(X @ Y^-1)`` (left)."""
         if side == "right":
-            return (other.inv() @ self).log()
+            return other.inv().compose(self).log()
         if side == "left":
-            return (self @ other.inv()).log()
+            return self.compose(other.inv()).log()
         raise ValueError(f"side must be 'right' or 'left', got {side!r}")
 
 
