@@ -489,7 +489,9 @@ def _compile_one(name, data, torch, backend):
     if not differentiable:
         return
     out.sum().backward()  # gradients flow through the compiled graph
-    assert all(t.grad is not None and bool(torch.isfinite(t.grad).all()) for t in targs)
+    # (an output may not depend on every input: J_tau of plus is J_r(tau) alone)
+    grads = [t.grad for t in targs if t.grad is not None]
+    assert grads and all(bool(torch.isfinite(g).all()) for g in grads)
 
 
 def test_torch_compile_objects_in_and_out(data, torch):
