@@ -205,7 +205,6 @@ def defer(check, arrays, args, relabel, trails=None):
     :class:`~rigidkit.errors.RigidkitError` with an index within the chunk.
     """
     import dask.array as da
-    from dask.array.core import unify_chunks
 
     trails = trails or (0,) * len(arrays)
     ref = arrays[0]
@@ -225,12 +224,7 @@ def defer(check, arrays, args, relabel, trails=None):
             if t:
                 a = a.rechunk({a.ndim - 1 - k: -1 for k in range(t)})
         pairs += [a, batch[nb - (a.ndim - t) :] + trail]
-    chunkss, unified = unify_chunks(*pairs)
-    pairs[::2] = unified
-    offsets = []
-    for letter in batch:
-        chunks = chunkss[letter]
-        offsets += [da.arange(sum(chunks), chunks=(chunks,)), letter]
+    chunkss, offsets = _unify_with_offsets(pairs, batch)
 
     def build(prev):
         # ``prev``, the check attached before on the same outputs, is an input:
@@ -331,7 +325,6 @@ def map_batched(fn, arrays, trails, relabel=None, outputs=None):
     NumPy path would, and gives the outputs' trailing shapes and dtypes.
     """
     import dask.array as da
-    from dask.array.core import unify_chunks
 
     nbs = [None if a is None else a.ndim - t for a, t in zip(arrays, trails)]
     nb = max(n for n in nbs if n is not None)
@@ -353,12 +346,7 @@ def map_batched(fn, arrays, trails, relabel=None, outputs=None):
         if t:
             a = a.rechunk({a.ndim - 1 - k: -1 for k in range(t)})
         pairs += [a, batch[nb - nbk :] + trail]
-    chunkss, unified = unify_chunks(*pairs)
-    pairs[::2] = unified
-    offsets = []
-    for letter in batch:
-        chunks = chunkss[letter]
-        offsets += [da.arange(sum(chunks), chunks=(chunks,)), letter]
+    chunkss, offsets = _unify_with_offsets(pairs, batch)
     combo = da.blockwise(
         _run_batched, batch, fn, None, relabel, None, len(arrays), None, nb, None,
         *pairs, *offsets, concatenate=True, dtype=object,
@@ -386,3 +374,19 @@ def map_batched(fn, arrays, trails, relabel=None, outputs=None):
 def any_dask(*xs) -> bool:
     """Whether any of ``xs`` is a Dask collection."""
     return any(type(x) is not np.ndarray and is_dask(x) for x in xs)
+
+
+def _unify_with_offsets(pairs, batch):
+    """Unify the chunks of ``pairs`` (array, index letters, ...) in place; return the
+    chunks per letter and, per batch letter, the global index of each element as a
+    blockwise argument, so that a check run per chunk names the global batch index."""
+    import dask.array as da
+    from dask.array.core import unify_chunks
+
+    chunkss, unified = unify_chunks(*pairs)
+    pairs[::2] = unified
+    offsets = []
+    for letter in batch:
+        chunks = chunkss[letter]
+        offsets += [da.arange(sum(chunks), chunks=(chunks,)), letter]
+    return chunkss, offsets
