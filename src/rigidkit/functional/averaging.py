@@ -138,10 +138,20 @@ def _chordal_loop(q, w, weighted, out):  # pragma: no cover - compiled by numba
     """``out[g]``: dominant eigenvector of ``sum_k w[g, k] q[g, k] q[g, k]^T``.
 
     The 10 distinct sums in one pass over the quaternions, then cyclic Jacobi
-    rotations on the 4x4 (Numerical Recipes' form: ``t = sgn(th) / (|th| +
-    sqrt(th^2 + 1))``, ``th = (a_qq - a_pp) / (2 a_pq)``) until the off-diagonal is
-    zero to rounding: Jacobi is accurate to a few ulp relative to the largest
-    eigenvalue, as LAPACK's ``syevd`` is.
+    rotations on the 4x4 (Numerical Recipes' ``jacobi``: ``t = sgn(th) / (|th| +
+    sqrt(th^2 + 1))``, ``th = (a_qq - a_pp) / (2 a_pq)``, updates through ``tau =
+    s / (1 + c)``) until a sweep rotates nothing. A pair is skipped (its
+    off-diagonal set to zero) once ``100 |a_pq|`` is below half an ulp of both
+    ``|a_pp|`` and ``|a_qq|``: the rotation would move those diagonals by less
+    than rounding, and the eigenvectors by ``a_pq / (a_qq - a_pp)``, below an
+    ulp unless the two eigenvalues agree to ~1e-14 relative, where the dominant
+    eigenvector is undetermined anyway. Driving the off-diagonals to exact zeros
+    instead (the first version) took one or two sweeps more on values down to
+    1e-300: 36 rotations where this takes ~20 (1.65 -> 1.16 us for a mean of two
+    rotations). Jacobi is accurate to a few ulp relative to the largest
+    eigenvalue, as LAPACK's ``syevd`` is (3000 random sets, 2 to 50 rotations,
+    spread 0.01 to 3 rad: within 1.3e-14 of the first version wherever the top
+    two eigenvalues differ by more than 1e-6 relative).
     """
     a = np.empty((4, 4), q.dtype)
     v = np.empty((4, 4), q.dtype)
@@ -175,37 +185,51 @@ def _chordal_loop(q, w, weighted, out):  # pragma: no cover - compiled by numba
             for j in range(4):
                 v[i, j] = 1.0 if i == j else 0.0
         for _sweep in range(50):
-            off = 0.0
-            for i in range(3):
-                for j in range(i + 1, 4):
-                    off += a[i, j] * a[i, j]
-            if off == 0.0:
-                break
+            rotated = False
             for i in range(3):
                 for j in range(i + 1, 4):
                     aij = a[i, j]
-                    if aij == 0.0:
+                    aii = a[i, i]
+                    ajj = a[j, j]
+                    g100 = 100.0 * abs(aij)
+                    if abs(aii) + g100 == abs(aii) and abs(ajj) + g100 == abs(ajj):
+                        a[i, j] = 0.0
+                        a[j, i] = 0.0
                         continue
-                    th = (a[j, j] - a[i, i]) / (2.0 * aij)
-                    t = 1.0 / (abs(th) + np.sqrt(th * th + 1.0))
-                    if th < 0.0:
-                        t = -t
+                    rotated = True
+                    h = ajj - aii
+                    if abs(h) + g100 == abs(h):
+                        t = aij / h
+                    else:
+                        th = 0.5 * h / aij
+                        t = 1.0 / (abs(th) + np.sqrt(th * th + 1.0))
+                        if th < 0.0:
+                            t = -t
                     c = 1.0 / np.sqrt(t * t + 1.0)
                     sn = t * c
-                    for k in range(4):
-                        x, y = a[k, i], a[k, j]
-                        a[k, i] = c * x - sn * y
-                        a[k, j] = sn * x + c * y
-                    for k in range(4):
-                        x, y = a[i, k], a[j, k]
-                        a[i, k] = c * x - sn * y
-                        a[j, k] = sn * x + c * y
-                    a[i, j] = 0.0  # exactly, by the choice of t
+                    tau = sn / (1.0 + c)
+                    d = t * aij
+                    a[i, i] = aii - d
+                    a[j, j] = ajj + d
+                    a[i, j] = 0.0
                     a[j, i] = 0.0
-                    for k in range(4):
-                        x, y = v[k, i], v[k, j]
-                        v[k, i] = c * x - sn * y
-                        v[k, j] = sn * x + c * y
+                    for r in range(4):
+                        if r != i and r != j:
+                            x = a[r, i]
+                            y = a[r, j]
+                            x2 = x - sn * (y + x * tau)
+                            y2 = y + sn * (x - y * tau)
+                            a[r, i] = x2
+                            a[i, r] = x2
+                            a[r, j] = y2
+                            a[j, r] = y2
+                    for r in range(4):
+                        x = v[r, i]
+                        y = v[r, j]
+                        v[r, i] = x - sn * (y + x * tau)
+                        v[r, j] = y + sn * (x - y * tau)
+            if not rotated:
+                break
         top = 0
         for i in range(1, 4):
             if a[i, i] > a[top, top]:
@@ -224,6 +248,8 @@ def _chordal_loop(q, w, weighted, out):  # pragma: no cover - compiled by numba
 GRAM_MIN = 2
 _GRAM = None
 _GRAM_JOB = None
+#: The compiled loop's unweighted ``w`` argument, one per dtype it is compiled for.
+_NO_WEIGHTS = {np.dtype(dt): np.empty((0, 0), dt) for dt in (np.float64, np.float32)}
 
 
 def _gram_ready() -> bool:
@@ -372,6 +398,22 @@ def quat_mean_unchecked(
 
     The weights are still validated. :meth:`rigidkit.Rotation.mean` calls this.
     """
+    if (
+        _GRAM is not None
+        and type(q) is np.ndarray
+        and weights is None
+        and axis is None
+        and method == "chordal"
+    ):
+        # The common call (one unweighted chordal mean of a NumPy batch) straight
+        # to the compiled loop: the general path's grouping and checks cost ~3 us,
+        # more than the loop itself below a thousand rotations.
+        empty = _NO_WEIGHTS.get(q.dtype)
+        n = q.size >> 2
+        if empty is not None and n >= 2 and q.flags.c_contiguous:
+            out = np.empty((1, 4), q.dtype)
+            _GRAM(q.reshape(1, n, 4), empty, False, out)
+            return out[0], 0
     if dask_backend.any_dask(q, weights):
         return _lazy_mean(quat_mean_unchecked, q, weights, axis, method, tol, max_iter)
     xp = namespace_of(q)
