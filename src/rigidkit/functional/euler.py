@@ -399,8 +399,44 @@ def euler_from_quat(seq, quat, *, degrees=False):
     >>> caught[0].category.__name__, angles + 0.0
     ('GimbalLockWarning', array([ 0., 90.,  0.]))
     """
-    s = parse_sequence(seq)  # the sequence first: its error is the likelier one
+    try:  # a known (seq, degrees, dtype): the sequence is valid
+        e = _CALLS[seq, degrees, quat.dtype]
+    except (KeyError, TypeError, AttributeError):
+        s = parse_sequence(seq)  # the sequence first: its error is the likelier one
+        if type(quat) is not np.ndarray:
+            return _euler_from_quat_validated(s, quat, degrees)
+        e = _call_args(seq, degrees, quat.dtype)
+    s, args = e[0], e[1]
+    dt = quat.dtype
+    if type(quat) is not np.ndarray or not (dt is _F64 or dt is _F32):
+        return _euler_from_quat_validated(s, quat, degrees)
+    if quat.shape[-1:] != (4,):  # the general path raises the ShapeError
+        return _euler_from_quat_validated(s, quat, degrees)
+    # Validated in the kernel's own pass (see kernels.euler.euler_from_quat_checked):
+    # a row that is not finite, zero or of extreme scale has a middle angle of
+    # 8 rad, which the lock scan below sends on to the full check.
+    angles = _k.euler_from_quat_checked(*e[4], quat)
+    if _lock_free(angles, e):
+        return angles
+    if bool((angles[..., 1] > 4.0 * args[5]).any()):
+        return _euler_from_quat_validated(s, quat, degrees)
+    _warn_if_locked(s, angles, args[5])
+    return angles
+
+
+def _euler_from_quat_validated(s: EulerSequence, quat, degrees):
+    """The general path of :func:`euler_from_quat`: validate first (any namespace)."""
     return euler_from_quat_unchecked(s.text, _checked_quat(quat), degrees=degrees)
+
+
+_F64 = np.dtype(np.float64)
+_F32 = np.dtype(np.float32)
+
+
+def _moderate_limit(dtype) -> float:
+    """``lim``: quaternions with ``|q|^2`` in ``[1 / lim, lim]`` go to the kernel as
+    they are (its lock test multiplies four components: ``lim^2`` must fit)."""
+    return 1e16 if is_float32(dtype) else 1e140
 
 
 def _checked_quat(quat):
@@ -410,17 +446,18 @@ def _checked_quat(quat):
     quaternion given, to the last bit near the lock too, where normalising first
     (one rounding of each component) would move the first and third angle by
     ``eps / distance`` (6e-9 rad at 1e-9 from the lock). Its lock test multiplies
-    four components, though, so a quaternion whose squared norm is outside
-    ``[1e-140, 1e140]`` (float32: ``[1e-16, 1e16]``) is replaced by its unit one.
+    four components, though, so a quaternion whose norm may be outside
+    ``[1e-70, 1e70]`` (float32: ``[1e-8, 1e8]``) is replaced by its unit one.
     """
     q = as_array(quat, (4,), "quaternion")
     unit = _conv.quat_normalize(q)  # raises for NaN, inf or zero, naming the index
     if isinstance(q, np.ndarray) and q.dtype.kind != "f":
         return unit
     xp = namespace_of(q)
-    lim = 1e16 if is_float32(q.dtype) else 1e140
-    n2 = xp.sum(q * q, axis=-1)
-    moderate = (n2 < lim) & (n2 > 1.0 / lim)
+    qmax = math.sqrt(_moderate_limit(q.dtype))
+    # |q| in [m, 2 m] for the largest component m (|q|^2 itself would overflow).
+    m = xp.max(xp.abs(q), axis=-1)
+    moderate = (m <= 0.5 * qmax) & (m >= 1.0 / qmax)
     if isinstance(moderate, np.ndarray) and moderate.all():
         return q
     return xp.where(moderate[..., None], q, unit)
@@ -440,37 +477,69 @@ def euler_from_quat_unchecked(seq, quat, *, degrees=False):
     array([1.57079633, 0.        , 0.        ])
     """
     try:  # the common case in one lookup: ~0.3 us less on a small batch
-        s, args, lo, hi = _CALLS[seq, degrees, quat.dtype]
+        e = _CALLS[seq, degrees, quat.dtype]
     except (KeyError, TypeError, AttributeError):
-        s, args, lo, hi = _call_args(seq, degrees, _dtype(quat))
+        e = _call_args(seq, degrees, _dtype(quat))
+    s, args = e[0], e[1]
     angles = _k.euler_from_quat(*args, quat)
-    if type(angles) is np.ndarray:
-        # Small NumPy batches: the middle angles as a list (two NumPy reductions
-        # cost ~1 us each). A NaN can only send a batch on to the full check.
-        if angles.ndim == 1:
-            if lo <= angles[1] <= hi:
-                return angles
-        elif angles.ndim == 2 and 0 < len(angles) <= 64:
-            vals = angles[:, 1].tolist()
-            if lo <= min(vals) and max(vals) <= hi:
-                return angles
+    if type(angles) is np.ndarray and _lock_free(angles, e):
+        return angles
     _warn_if_locked(s, angles, args[5])
     return angles
 
 
+#: NumPy batches up to this long have their middle angles scanned as a sorted Python
+#: list (one C call, ~0.6 us at 10 elements, 1.1 us at 32), longer ones with NumPy
+#: (~1.5 us: two ufunc calls, or three for proper sequences).
+LIST_SCAN_MAX = 40
+
+
+def _lock_free(angles, e) -> bool:
+    """True when the middle angles of NumPy ``angles`` are all at least
+    :func:`gimbal_lock_threshold` from the lock (``e``: the entry of
+    :func:`_call_args`), with the arithmetic of :func:`_warn_if_locked`.
+
+    False sends the call on to :func:`_warn_if_locked` (which finds out whether
+    any is near the lock) or, in :func:`euler_from_quat`, to the full check. A
+    NaN may give either answer here (a sorted list with NaN is not ordered, where
+    NumPy's max propagates it): it is never a lock, so both are right.
+    """
+    if angles.ndim == 1:
+        return e[2] <= angles.item(1) <= e[3]
+    if angles.ndim != 2:
+        return False
+    n = len(angles)
+    if n <= LIST_SCAN_MAX:
+        if n == 0:
+            return True
+        vals = sorted(angles[:, 1].tolist())
+        return e[2] <= vals[0] and vals[-1] <= e[3]
+    center = e[5]
+    if center == 0.0:  # Tait-Bryan: the lock at +-pi/2
+        dist = np.abs(angles[:, 1])
+    else:
+        dist = angles[:, 1] - center
+        np.abs(dist, out=dist)
+    return bool(_MAX(dist) <= e[6])
+
+
+_MAX = np.maximum.reduce
 _CALLS: dict = {}
 
 
 def _call_args(seq, degrees, dtype) -> tuple:
-    """``(sequence, kernel parameters, lo, hi)`` of a call; middle angles in [lo, hi]
-    are not near the lock (see :func:`_warn_if_locked`). Memoised per hashable dtype."""
+    """``(sequence, kernel parameters, lo, hi, checked kernel parameters, center,
+    width)`` of a call: middle angles in ``[lo, hi]``, i.e. with ``|mid - center| <=
+    width``, are not near the lock (see :func:`_warn_if_locked`). Memoised per
+    hashable dtype."""
     s = parse_sequence(seq)
     scale = 180.0 / math.pi if degrees else 1.0
     args = (*s.params, scale, lock_tolerance(dtype))
     tol = gimbal_lock_threshold(dtype) * scale
     half = 0.5 * math.pi * scale
     center = half if s.proper else 0.0
-    entry = (s, args, center - half + tol, center + half - tol)
+    cargs = (*args, math.sqrt(_moderate_limit(dtype)))
+    entry = (s, args, center - half + tol, center + half - tol, cargs, center, half - tol)
     try:
         _CALLS[seq, bool(degrees), dtype] = entry
     except TypeError:  # an unhashable dtype object

@@ -228,3 +228,50 @@ def euler_from_quat(e1, e2, parity, proper, reverse, scale, tol, w, x, y, z):
     # mid_c >= +0: atan2 in [-pi/2, pi/2], no fold needed.
     mid = where(is_proper, 2.0, 1.0) * atan2(mid_s, mid_c)
     return (first * scale, mid * scale, third * scale)
+
+
+@kernel(
+    inputs=[(4,)],
+    outputs=[(3,)],
+    params=("e1", "e2", "parity", "proper", "reverse", "scale", "tol", "qmax"),
+)
+def euler_from_quat_checked(e1, e2, parity, proper, reverse, scale, tol, qmax, w, x, y, z):
+    """:func:`euler_from_quat` with its input checked in the same pass.
+
+    A row of moderate scale, ``|q|`` in ``[1 / qmax, qmax]`` (``qmax`` 1e70 for
+    float64, 1e8 for float32: the lock test's fourth powers stay in range), gets
+    the angles of :func:`euler_from_quat`, to the bit. Any other row (NaN, inf,
+    zero, an extreme scale) gets a middle angle of ``8 scale``, outside every valid
+    range (``[0, pi]``, ``[-pi/2, pi/2]``), and is computed as the zero quaternion,
+    so that no operation meets an inf or a NaN (no floating-point warnings on any
+    binding). The caller's scan of the middle angles for gimbal lock, which every
+    call makes, then finds such rows too: validating costs no extra pass and no
+    NumPy call on the common path.
+
+    The scale is measured by ``m = (|w| + |x| + |y| + |z|) / 4``, which cannot
+    overflow and propagates NaN (a maximum would drop it in Python's ``max``);
+    ``|q| / 4 <= m <= |q| / 2``, so the rows passed are well inside the range and
+    those within a factor 4 of its ends are flagged too (the caller's full check
+    then takes them as they are).
+    """
+    m = 0.25 * (abs(w) + abs(x) + abs(y) + abs(z))
+    ok = (m <= 0.25 * qmax) & (m >= 0.5 / qmax)  # False for NaN
+    # A bad row is computed as the zero quaternion (zero angles, no inf or NaN met).
+    # Its zero is ``w < w``, False: a zero of the inputs' own type, where a literal
+    # 0.0 would make numba compute every float32 row in float64, no longer the bits
+    # of euler_from_quat.
+    zero = w < w
+    first, mid, third = euler_from_quat(
+        e1,
+        e2,
+        parity,
+        proper,
+        reverse,
+        scale,
+        tol,
+        where(ok, w, zero),
+        where(ok, x, zero),
+        where(ok, y, zero),
+        where(ok, z, zero),
+    )
+    return (first, where(ok, mid, 8.0 * scale), third)
