@@ -48,6 +48,8 @@ def slerp(a, b, t, *, decoupled=False):
     >>> np.round(rk.slerp(A_R_B, A_R_C, [0.0, 0.5, 1.0]).as_rotvec()[:, 2], 12)
     array([0.        , 0.78539816, 1.57079633])
     """
+    if type(a) is Rotation and type(b) is Rotation and not decoupled:  # the common call
+        return Rotation._wrap(_fi.quat_slerp_unchecked(a._quat, b._quat, t))
     if isinstance(a, Transform) and isinstance(b, Transform):
         return Transform._wrap(
             _fi.pose_slerp_unchecked(a._pose, b._pose, t, decoupled=decoupled)

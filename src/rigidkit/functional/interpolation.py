@@ -15,6 +15,10 @@ array([0.70710678, 0.        , 0.        , 0.70710678])
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
+
 from .._engine.namespace import namespace_of
 from .._validate import as_array, as_float, finite_array
 from ..kernels import geodesic as _k
@@ -45,6 +49,14 @@ def _pose(p, what):
 
 
 def _fraction(t):
+    """``t`` checked finite, as an array (float64 for integers)."""
+    if type(t) is np.ndarray and t.dtype.kind == "f" and t.size <= 16:
+        # One element or a few (slerp's common calls): a Python loop over the
+        # values costs less than the general check's ufunc calls (1.1 -> 0.4 us).
+        if all(map(math.isfinite, t.ravel().tolist())):
+            return t
+    elif type(t) is float and math.isfinite(t):
+        return np.asarray(t)
     return as_float(finite_array(t, (), "interpolation parameter t"))
 
 
@@ -170,7 +182,5 @@ def segment_index(knots, times):
     -------
     ndarray of intp, shape (...)
     """
-    import numpy as np
-
     idx = np.searchsorted(knots, times, side="left") - 1
     return np.clip(idx, 0, len(knots) - 2)

@@ -1,0 +1,63 @@
+"""The NumPy fast paths of slerp and the chordal mean against independent references.
+
+``Rotation.mean()`` (unweighted, whole batch) goes straight to the compiled Gram
+loop and its Jacobi solve once that is compiled; ``rk.slerp`` checks a few ``t``
+values in Python. References: ``numpy.linalg.eigh`` of the 4x4 sum (the chordal
+mean's definition) and scipy's ``A * from_rotvec(t (A^-1 B).as_rotvec())``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation as SR
+
+import rigidkit as rk
+from conftest import quat_angle
+
+
+def _ready_gram():
+    from rigidkit.functional import averaging
+
+    if not averaging._gram_ready():
+        if averaging._GRAM_JOB is None:
+            pytest.skip("numba is not available")
+        averaging._GRAM_JOB.join()
+
+
+@pytest.mark.parametrize(
+    "shape, dtype, tol",
+    [((2,), np.float64, 1e-13), ((37,), np.float64, 1e-13), ((3, 5), np.float64, 1e-13),
+     ((40,), np.float32, 1e-5)],
+)  # fmt: skip
+def test_unweighted_mean_fast_path_is_the_dominant_eigenvector(shape, dtype, tol, rng):
+    _ready_gram()
+    q = rng.standard_normal(shape + (4,))
+    q[..., 0] += 2.0  # a cluster, so the top eigenvalue is well separated
+    q *= rng.choice([-1.0, 1.0], size=shape + (1,))  # signs must not matter
+    R = rk.Rotation.from_quat(q.astype(dtype))
+    got = R.mean().as_quat()
+    flat = np.asarray(R.as_quat(), dtype=np.float64).reshape(-1, 4)
+    ref = np.linalg.eigh(flat.T @ flat)[1][:, -1]
+    assert got.shape == (4,) and got.dtype == dtype
+    assert got[0] >= 0.0
+    assert quat_angle(got, ref) < tol
+    # A strided view takes the general path and must give the same mean.
+    wide = rk.Rotation.from_quat(np.repeat(q.astype(dtype), 2, axis=0))
+    assert quat_angle(wide[::2].mean().as_quat(), got) < tol
+
+
+def test_slerp_fraction_checks(rng):
+    q = rng.standard_normal((2, 5, 4))
+    A, B = rk.Rotation.from_quat(q[0]), rk.Rotation.from_quat(q[1])
+    t = rng.uniform(-0.5, 1.5, 5)
+    sa = SR.from_quat(np.asarray(A.as_quat()), scalar_first=True)
+    sb = SR.from_quat(np.asarray(B.as_quat()), scalar_first=True)
+    ref = (sa * SR.from_rotvec((sa.inv() * sb).as_rotvec() * t[:, None])).as_quat(
+        scalar_first=True
+    )
+    assert np.all(quat_angle(rk.slerp(A, B, t).as_quat(), ref) < 1e-14)
+    np.testing.assert_array_equal(rk.slerp(A[0], B[0], 0.0).as_quat(), A[0].as_quat())
+    for bad in (np.nan, np.inf, np.array([0.5, np.nan, 0.1, 0.2, 0.3])):
+        with pytest.raises(rk.NonFiniteError):
+            rk.slerp(A, B, bad)
