@@ -264,10 +264,12 @@ def check_finite(x, trail: tuple, what: str) -> None:
     if isinstance(x, np.ndarray):
         if x.dtype.kind != "f":
             return
-        if x.size <= 16:  # a ufunc call costs more than this loop for one element
-            if all(map(math.isfinite, x.ravel().tolist())):
-                return
-        elif np.isfinite(x).all():
+        # Up to 64 components a Python sum is cheaper than a ufunc and a reduction
+        # (0.6 us against 1.4 at 30): a NaN or inf term keeps the sum non-finite,
+        # and a sum that overflows only sends us on to the exact test.
+        if x.size <= 64 and math.isfinite(sum(x.ravel().tolist())):
+            return
+        if np.isfinite(x).all():
             return
         bad = ~np.isfinite(x)
     elif isinstance(x, (int, float)):
