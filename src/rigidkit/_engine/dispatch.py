@@ -5,8 +5,9 @@ so for each kernel we write one, straight-line, with its shapes as constants (no
 loops over the inputs, no lists, no ``math.prod``): on a 10-element batch the
 bookkeeping would otherwise cost more than the arithmetic. It serves
 
-* one element (every array exactly its trailing shape, batch ``()``): the kernel
-  over Python floats;
+* one element (every array exactly its trailing shape, batch ``()``): the
+  compiled one-element loop once the kernel is hot there (its inputs of any
+  strides), else the kernel over Python floats;
 * a batch with one batch axis, every input either of that batch or a single row
   for the whole batch (``R0.apply(points)``), C-contiguous, all float32 or all
   float64, below ``PARALLEL_MIN``, whose compiled loop is ready: the numba loop
@@ -16,22 +17,30 @@ Anything else (other array namespaces, broadcasting between batch shapes, N-D
 batches, conversions, a loop not yet loaded, a forced binding, bad shapes)
 returns to :meth:`Kernel._call`, the general path, with the same arguments.
 
+The loops called here are the compiled entry points of the loops (the tables
+``E_*``, see :func:`entry_point`), not their numba dispatchers: a dispatcher
+types every argument before it runs (~0.1 us of a 0.2 us call), and these checks
+have established all it would: exact ``ndarray`` type, the dtype of the loop,
+the number of dimensions and the trailing shape, C-contiguity (but for the
+inputs of the one-element loop, typed of any layout), and for an
+``out=`` buffer that it is writable (``flags.carray``; a dispatcher refuses a
+read-only one, the entry point would write into it). The general path keeps the
+dispatchers, which check their arguments themselves.
+
 The source for ``quat_apply`` (inputs ``(4,), (3,)``, output ``(3,)``) reads::
 
     def fast(self, a0, a1, out=None, backend=None):
-        if backend is None and type(a0) is ndarray and type(a1) is ndarray \
-and K.BINDING is None:
+        if backend is None and type(a0) is ndarray and type(a1) is ndarray:
             dt = a0.dtype
             s0 = a0.shape
             s1 = a1.shape
             if a1.dtype is dt:
                 if s0 == (4,) and s1 == (3,):
                     ...  # one element
-                elif s0[-1:] == (4,) and s1[-1:] == (3,):
-                    b0 = s0[:-1]
-                    b1 = s1[:-1]
+                elif len(s0) == 2 and s0[1] == 4 and len(s1) == 2 and ... \
+and K.BINDING is None:
                     ...  # one branch per broadcast pattern
-    return self._call(a0, a1, out=out, backend=backend)
+        return self._call(a0, a1, out=out, backend=backend)
 """
 
 from __future__ import annotations
@@ -39,14 +48,18 @@ from __future__ import annotations
 import math
 
 
-def _trail_check(shape_var: str, trail: tuple) -> str:
-    nt = len(trail)
-    return f"{shape_var}[-{nt}:] == {trail!r}" if nt else ""
+def entry_point(loop):
+    """The compiled entry point of a numba dispatcher of one signature (else ``loop``).
 
-
-def _batch_expr(shape_var: str, trail: tuple) -> str:
-    nt = len(trail)
-    return f"{shape_var}[:-{nt}]" if nt else shape_var
+    It unboxes its arguments as the signature says without checking them (an
+    array of another dtype, rank or layout would be misread), so only callers
+    that have checked them, as :func:`fast_source`'s code does, may call it.
+    """
+    try:
+        (sig,) = loop.signatures
+        return loop.overloads[sig].entry_point
+    except (AttributeError, KeyError, TypeError, ValueError):
+        return loop
 
 
 def _loop_key(params) -> str:
@@ -82,7 +95,9 @@ def _run_loop(outs, args, shape_source) -> list[str]:
     """Lines that run ``loop`` into fresh outputs or a fitting ``out=``.
 
     ``shape_source(s)``: the source of the whole shape of an output of trailing
-    shape ``s`` (a constant for one element, ``(n, *s)`` for a batch).
+    shape ``s`` (a constant for one element, ``(n, *s)`` for a batch). An
+    ``out=`` buffer must be writable too (``flags.carray``: C-contiguous,
+    aligned and writable), as the entry point does not check it.
     """
     onames = [f"o{k}" for k in range(len(outs))]
     lines = ["if out is None:"]
@@ -96,7 +111,7 @@ def _run_loop(outs, args, shape_source) -> list[str]:
     if len(outs) == 1:
         lines.append(
             "if type(out) is ndarray and out.dtype is dt and out.shape == "
-            f"{shape_source(outs[0])} and out.flags.c_contiguous:"
+            f"{shape_source(outs[0])} and out.flags.carray:"
         )
         lines.append(f"    loop({', '.join(args)}, out)")
         lines.append("    return out")
@@ -111,7 +126,7 @@ def _run_single(outs, args) -> list[str]:
 def fast_source(kernel, has_single=False) -> str:
     """Source of ``fast(self, *params, *arrays, out=None, backend=None)``.
 
-    ``has_single``: the kernel can have a one-element loop (table ``R_single``).
+    ``has_single``: the kernel can have a one-element loop (table ``E_single``).
     """
     nparams = len(kernel.params)
     params = [f"p{k}" for k in range(nparams)]
@@ -119,13 +134,14 @@ def fast_source(kernel, has_single=False) -> str:
     ins = kernel.inputs
     outs = kernel.outputs
     signature = ", ".join(params + names + ["out=None", "backend=None"])
+    general = f"self._call({', '.join(params + names)}, out=out, backend=backend)"
     L = []
     if params:  # the memos of _get_loop, one per ready-loop table
-        tables = ["R_single"] if has_single else []
-        tables.append(f"R{_tag(tuple(False for _ in ins))}")
+        tables = ["E_single"] if has_single else []
+        tables.append(f"E{_tag(tuple(False for _ in ins))}")
         if len(ins) > 1:
             tables += [
-                f"R{_tag(tuple(k == j for k in range(len(ins))))}" for j in range(len(ins))
+                f"E{_tag(tuple(k == j for k in range(len(ins))))}" for j in range(len(ins))
             ]
         L += [f"M{t} = {{}}" for t in tables]
     L.append(f"def fast(self, {signature}):")
@@ -141,18 +157,22 @@ def fast_source(kernel, has_single=False) -> str:
     # -- one element -------------------------------------------------------------
     single = " and ".join(f"s{k} == {tuple(t)!r}" for k, t in enumerate(ins))
     L.append(f"            if {single}:")
-    L.append("                if dt is F64 or dt is F32:")
     if has_single:
         # The compiled one-element loop (once this kernel is hot at one element):
-        # ~0.4 us of dispatch, less than packing Python floats into a new array.
+        # ~0.2 us of call, less than packing Python floats into a new array. A
+        # loop in the table implies a float32 or float64 dtype.
         lkey = _loop_key(params)
-        L += _get_loop("R_single", params, 20)
-        contig = " and ".join(f"{a}.flags.c_contiguous" for a in names)
-        L.append(f"                    if loop is not None and {contig}:")
+        L += _get_loop("E_single", params, 16)
+        L.append("                if loop is None:")
+        L.append("                    if dt is not F64 and dt is not F32:")
+        L.append(f"                        return {general}")
+        L.append(f"                    self._single_seen({lkey})")
+        L.append("                else:  # its inputs may have any strides")
         sargs = list(params) + names
-        L += ["                        " + x for x in _run_single(outs, sargs)]
-        L.append("                    elif loop is None:")
-        L.append(f"                        self._single_seen({lkey})")
+        L += ["                    " + x for x in _run_single(outs, sargs)]
+    else:
+        L.append("                if dt is not F64 and dt is not F32:")
+        L.append(f"                    return {general}")
     call = list(params)
     for a, s in zip(names, ins):
         if len(s) == 0:
@@ -161,16 +181,15 @@ def fast_source(kernel, has_single=False) -> str:
             call.append(f"*{a}.tolist()")
         else:
             call.append(f"*{a}.ravel().tolist()")
-    L.append(f"                    r = py({', '.join(call)})")
-    L.append("                    if out is None:")
-    L += ["                        " + line for line in _pack_single(outs)]
-    L.append("                    return self._single_out(r, out, dt)")
+    L.append(f"                r = py({', '.join(call)})")
+    L.append("                if out is None:")
+    L += ["                    " + line for line in _pack_single(outs)]
+    L.append("                return self._single_out(r, out, dt)")
     # -- one batch axis: index tests on the shapes (a slice costs ~60 ns each) -------
     patterns = [(None, tuple(False for _ in ins))]
     if len(ins) > 1:
         for j in range(len(ins)):
             patterns.append((j, tuple(k == j for k in range(len(ins)))))
-    kw = "elif"
     for j, bcast in patterns:
         others = [k for k in range(len(ins)) if k != j]
         ref = others[0]
@@ -181,20 +200,18 @@ def fast_source(kernel, has_single=False) -> str:
             conds += [f"s{k}[{1 + d}] == {size}" for d, size in enumerate(t)]
             if k != ref:
                 conds.append(f"s{k}[0] == s{ref}[0]")
-        L.append(f"            {kw} {' and '.join(conds)} and K.BINDING is None:")
-        L += _get_loop(f"R{_tag(bcast)}", params, 16)
+        L.append(f"            elif {' and '.join(conds)} and K.BINDING is None:")
+        L += _get_loop(f"E{_tag(bcast)}", params, 16)
         # A broadcast row of one axis is passed as it is (others are raveled).
         plain = [k for k in range(len(ins)) if k != j or len(ins[k]) == 1]
         contig = " and ".join(f"{names[k]}.flags.c_contiguous" for k in plain)
         L.append(f"                n = s{ref}[0]")
-        L.append(f"                if loop is not None and {contig} and n < PMIN:")
+        L.append(f"                if loop is not None and n < PMIN and {contig}:")
         args = list(params)
         for k, (a, t) in enumerate(zip(names, ins)):
             args.append(f"{a}.ravel()" if bcast[k] and len(t) != 1 else a)
         L += ["                    " + line for line in _run_batch(outs, args)]
-    L.append(
-        f"    return self._call({', '.join(params + names)}, out=out, backend=backend)"
-    )
+    L.append(f"    return {general}")
     return "\n".join(L) + "\n"
 
 

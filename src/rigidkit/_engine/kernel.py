@@ -17,10 +17,11 @@ shape of each array input and output, and turns the function into a
 
 Dispatch, for ``a = kernel(arrays...)``:
 
-* NumPy, one element: the function itself over Python floats (lowest latency);
+* NumPy, one element: the function itself over Python floats, or, once the
+  kernel is hot there (``SINGLE_HOT`` calls), its compiled one-element loop;
 * NumPy, a batch whose compiled loop is ready: the fused numba loop, called
-  from a generated entry point (:mod:`.dispatch`) that costs ~1 us, split over
-  cores for large batches;
+  from a generated entry point (:mod:`.dispatch`) whose checks cost ~0.25 us
+  (a call at N = 10 is ~0.8 us in all), split over cores for large batches;
 * NumPy, a batch whose loop is not ready yet: the loop is requested from the
   background thread (:func:`.numba_backend.request`, which imports numba and
   compiles or loads the loop from the disk cache) and this batch runs without
@@ -277,6 +278,9 @@ class Kernel(_Rebindable):
         # Filled by the background loader (numba_backend.request); read without a
         # lock by the fast path, so entries are only ever added.
         self._ready: dict = {}
+        # The same loops' compiled entry points, for the fast path only (see
+        # dispatch.entry_point): {broadcast pattern: {dtype: entry point}}.
+        self._entry: dict = {}
         self._nsingle: dict = {}  # one-element calls counted per loop key
         _TORCH_KERNELS.add(self)
         if _TORCH_BOUND:
@@ -357,12 +361,12 @@ class Kernel(_Rebindable):
             bcast = tuple(k == j for k in range(len(self.inputs)))
             if j is not None and len(self.inputs) < 2:
                 continue
-            env["R_" + "".join("b" if b else "n" for b in bcast)] = self._ready.setdefault(
+            env["E_" + "".join("b" if b else "n" for b in bcast)] = self._entry.setdefault(
                 bcast, {}
             )
         single = numba_backend.has_single(self)
         if single:
-            env["R_single"] = self._ready.setdefault(numba_backend.SINGLE, {})
+            env["E_single"] = self._entry.setdefault(numba_backend.SINGLE, {})
         src = fast_source(self, has_single=single)
         exec(compile(src, f"<rigidkit fast {self.name}>", "exec"), env)
         return env["fast"]
@@ -428,8 +432,8 @@ class Kernel(_Rebindable):
                 o[()] = res[k]
             elif len(s) == 1:
                 o[:] = res[k : k + m]
-            else:
-                o.reshape(-1)[:] = res[k : k + m]
+            else:  # .flat: a strided buffer's reshape(-1) would be a copy
+                o.flat = res[k : k + m]
             k += m
         return self._finish(outs)
 
@@ -440,7 +444,10 @@ class Kernel(_Rebindable):
         parameters by ``(dtype, ints)`` (which parameters are integers, see
         :func:`_ints`): each combination is its own compiled signature.
         """
+        from .dispatch import entry_point
+
         key = (dtype, ints) if self.params else dtype
+        self._entry.setdefault(bcast, {})[key] = entry_point(loop)
         self._ready.setdefault(bcast, {})[key] = loop
 
     def _batch_shape(self, xp, arrays):

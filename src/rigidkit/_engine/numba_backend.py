@@ -19,8 +19,9 @@ is ready. :func:`wait` blocks for a loop (tests and ``backend="numba"``), and
 ``python -m rigidkit._engine.numba_backend`` compiles every shipped kernel (an
 install step: afterwards a fresh process only loads from disk).
 
-The loop is compiled with ``nogil=True``; large batches are split over threads
+A batch loop is compiled with ``nogil=True``; large batches are split over threads
 (see :func:`run_loop`), so one compile serves the serial and the parallel path.
+Loops are compiled without NRT (see :func:`loop_options`).
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ import os
 import sys
 import threading
 
-from .primitives import NUMBA_PRELUDE
+from .primitives import numba_prelude
 
 _AVAILABLE = None
 _LOCK = threading.Lock()
@@ -95,14 +96,22 @@ SINGLE = "single"
 
 
 def _single_source(kernel) -> str:
-    """One evaluation on arrays of exactly their trailing shapes (see ``SINGLE``)."""
+    """One evaluation on arrays of exactly their trailing shapes (see ``SINGLE``).
+
+    Inputs are read by their own indices (``A0[1, 2]``), not through a flat view:
+    they may be strided (see :func:`signature`).
+    """
     nparams = len(kernel.params)
     args = [f"p{k}" for k in range(nparams)]
     pre, call = [], [f"p{k}" for k in range(nparams)]
     for k, shape in enumerate(kernel.inputs):
         args.append(f"A{k}")
-        pre.append(f"    a{k} = A{k}.reshape({_size(shape)})")
-        call += [f"a{k}[{c}]" for c in range(_size(shape))]
+        for c in range(_size(shape)):
+            index, rest = [], c
+            for d in reversed(shape):
+                index.insert(0, str(rest % d))
+                rest //= d
+            call.append(f"A{k}[{', '.join(index)}]")
     body = [f"    r = {kernel.name}({', '.join(call)})"]
     j = 0
     for k, shape in enumerate(kernel.outputs):
@@ -190,8 +199,8 @@ def _has_star_call(fn) -> bool:
 
 
 def module_source(kernel, bcast=()) -> str:
-    parts = [NUMBA_PRELUDE]
     fns = [*kernel.dependencies(), kernel]
+    parts = [numba_prelude([f.fn for f in fns])]  # with the fast atan2 where it pays
     nargs = len(kernel.params) + sum(_size(s) for s in kernel.inputs)
     # Inlined at numba-IR level, the kernel and its helpers fuse into the loop body
     # (LLVM alone does not inline across numba functions). Numba's inliner cannot
@@ -206,6 +215,9 @@ def module_source(kernel, bcast=()) -> str:
         parts.append("\n\n" + deco + "\n" + function_source(f.fn))
     loop = _single_source(kernel) if bcast == SINGLE else _loop_source(kernel, bcast)
     parts.append("\n\n" + loop)
+    # numba's disk cache is keyed by the source, not by the options: a loop cached
+    # with other options must not be taken for this one.
+    parts.append(f"\n# compiled with {sorted(loop_options(bcast).items())!r}\n")
     return "\n".join(parts)
 
 
@@ -268,7 +280,9 @@ def signature(kernel, bcast, dtype, ints=()):
     dt = types.float32 if dtype.itemsize == 4 else types.float64
     args = [types.int64 if i else types.float64 for i in ints]
     if bcast == SINGLE:
-        args += [types.Array(dt, len(s), "C", readonly=True) for s in kernel.inputs]
+        # Inputs of any layout (one element: strides cost nothing), so that the
+        # fast entry need not check their contiguity (~0.05 us per input).
+        args += [types.Array(dt, len(s), "A", readonly=True) for s in kernel.inputs]
         args += [types.Array(dt, len(s), "C") for s in kernel.outputs]
         return types.void(*args)
     for k, shape in enumerate(kernel.inputs):
@@ -288,7 +302,19 @@ def compile_loop(kernel, bcast, dtype, ints=()):
 
     module, cache = _module(kernel, bcast)
     sig = signature(kernel, bcast, dtype, ints)
-    return numba.njit([sig], cache=cache, nogil=True, error_model="numpy")(module.loop)
+    return numba.njit([sig], cache=cache, **loop_options(bcast))(module.loop)
+
+
+def loop_options(bcast) -> dict:
+    """The options a loop is compiled with (also written into its module's source).
+
+    A loop allocates nothing, so it needs no NRT (numba's reference counting):
+    without it a call unboxes each array without allocating a meminfo for it,
+    ~0.1 us less per call (SE(3) compose at one element 1.23 -> 1.04 us). Batch
+    loops release the GIL (``nogil``: large batches are split over threads); the
+    one-element loop keeps it, which saves ~0.04 us more.
+    """
+    return {"nogil": bcast != SINGLE, "error_model": "numpy", "_nrt": False}
 
 
 # -- the background loader ---------------------------------------------------------
