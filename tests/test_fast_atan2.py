@@ -1,8 +1,9 @@
 """The numba loops' own ``atan2`` (``NUMBA_PRELUDE``) against mpmath at 40 digits.
 
-Numba's ``math.atan2`` calls libm, ~20 ns an element and never vectorised, so the
-generated loops use a branch-free one (see ``rigidkit._engine.primitives``). Here it
-runs through the engine's real path, a kernel bound to numba, on:
+Numba's ``math.atan2`` calls libm, ~20 ns an element and never vectorised, so a
+generated loop that can be vectorised (no other libm call) uses a branch-free one,
+``FAST_ATAN2`` (see ``rigidkit._engine.primitives.numba_prelude``). Here it runs
+through the engine's real path, a kernel bound to numba, on:
 
 * random pairs at scales 1e-300 ... 1e300, and with unrelated scales (tiny ratios);
 * both sides, by a few ulp, of every threshold: ``|y|/|x| = tan(pi/8)`` (the two
@@ -26,12 +27,33 @@ import math
 import mpmath
 import numpy as np
 
-from rigidkit._engine import kernel
+from rigidkit._engine import kernel, numba_backend
+from rigidkit._engine.primitives import FAST_ATAN2, NUMBA_PRELUDE, numba_prelude
 
 
 @kernel(inputs=[(), ()], outputs=[()])
 def _angle(y, x):
     return (atan2(y, x),)
+
+
+def test_the_loops_here_and_only_vectorisable_ones_get_the_fast_atan2():
+    """What the rest of this file measures is FAST_ATAN2, not libm's; a kernel that
+    calls another libm function (its loop stays scalar) keeps libm's."""
+    assert FAST_ATAN2 in numba_backend.module_source(_angle, (False, False))
+
+    def with_sin(y, x):
+        return atan2(y, x) * sin(x)
+
+    def with_nested_exp(y, x):
+        return (lambda v: exp(v))(atan2(y, x))
+
+    def without_atan2(y, x):
+        return sqrt(y * y + x * x)
+
+    assert numba_prelude([_angle.fn]) == NUMBA_PRELUDE + FAST_ATAN2
+    assert numba_prelude([_angle.fn, with_sin]) == NUMBA_PRELUDE
+    assert numba_prelude([with_nested_exp]) == NUMBA_PRELUDE
+    assert numba_prelude([without_atan2]) == NUMBA_PRELUDE
 
 
 def _numba_atan2(y, x):

@@ -5,8 +5,8 @@ the primitives listed in :data:`PRIMITIVES`, other helper kernels, and literals.
 Each backend evaluates the same function object with its own globals:
 
 * ``math``   : plain Python floats (one element) and, textually, numba loops
-  (:data:`NUMBA_PRELUDE`: the same functions, except a branch-free ``atan2``
-  within 0.66 ulp of the exact value, like libm's, and vectorised);
+  (:data:`NUMBA_PRELUDE`; a loop that can be vectorised gets a branch-free
+  ``atan2`` of its own, :data:`FAST_ATAN2`, within 0.66 ulp like libm's);
 * ``xp``     : element-wise over arrays of any array-API namespace;
 * ``sympy``  : symbolic expressions.
 
@@ -65,12 +65,12 @@ def math_bindings() -> dict:
     }
 
 
-#: Source text of the same primitives for a generated numba module. Its ``atan2``
-#: is its own (vectorisable, <= 0.66 ulp, finite inputs only); the rest are ``math``'s.
+#: Source text of the same primitives for a generated numba module (``math``'s
+#: functions; see :func:`numba_prelude` for the module of a kernel).
 NUMBA_PRELUDE = """\
 import math
 import numba
-from math import sqrt, sin, cos, tan, asin, acos, atan, exp, log, copysign, pi
+from math import sqrt, sin, cos, tan, asin, acos, atan, atan2, exp, log, copysign, pi
 
 
 @numba.njit(inline="always", error_model="numpy")
@@ -86,13 +86,23 @@ def maximum(a, b):
 @numba.njit(inline="always", error_model="numpy")
 def minimum(a, b):
     return a if a <= b else b
+"""
 
+
+#: A branch-free ``atan2`` for numba loops, to follow :data:`NUMBA_PRELUDE` (it
+#: replaces ``math.atan2`` there): within 0.66 ulp of the exact value (glibc's:
+#: 0.79), finite inputs only. Vectorised it costs ~2.6 ns an element against libm's
+#: ~20; in a loop that stays scalar it is slower than libm's (~170 instructions,
+#: its selects become branches, values spilled around every other libm call; SE(3)
+#: log 74 -> 105 ns an element), hence :func:`numba_prelude`.
+FAST_ATAN2 = """
 
 @numba.njit(inline="always", error_model="numpy")
 def atan2(y, x):
     # numba's math.atan2 calls libm (~20 ns an element, never vectorised); this one
-    # is conditional expressions (LLVM selects) and two divisions, ~2.7 ns, within
-    # 0.66 ulp of the exact value (glibc's 0.79). Signed zeros as libm's:
+    # is conditional expressions (LLVM selects, blends once vectorised) and two
+    # divisions, ~2.6 ns, within 0.66 ulp of the exact value (glibc's 0.79), a
+    # degree-10 polynomial rather than libm's tables. Signed zeros as libm's:
     # atan2(+-0, -0) = +-pi, atan2(-0, x > 0) = -0; NaN in, NaN out. Finite
     # inputs only (an infinity gives NaN): kernels get validated, finite data.
     # The error-free steps below need IEEE order of operations: no fastmath.
@@ -174,6 +184,34 @@ def atan2(y, x):
     tail = tail + (st * (s * p) + (lo + sg * t_lo * (1.0 - s)))
     return copysign(head + tail, y)
 """
+
+#: ``math`` functions that numba calls in libm: a loop calling one is not vectorised.
+LIBM_CALLS = frozenset({"sin", "cos", "tan", "asin", "acos", "atan", "exp", "log"})
+
+
+def _global_names(code) -> set:
+    names = set(code.co_names)
+    for c in code.co_consts:
+        if hasattr(c, "co_code"):
+            names |= _global_names(c)
+    return names
+
+
+def numba_prelude(functions) -> str:
+    """The prelude of a generated module holding the Python ``functions``.
+
+    :data:`NUMBA_PRELUDE`, plus :data:`FAST_ATAN2` if they call ``atan2`` and no
+    other libm function (:data:`LIBM_CALLS`): only then can the loop be vectorised,
+    where the fast ``atan2`` is 8x libm's; in a scalar loop libm's is faster. Names
+    are read from the bytecode (no docstring or comment can match). Modules that do
+    not call ``atan2`` keep the plain prelude (and their numba disk cache).
+    """
+    names = set()
+    for fn in functions:
+        names |= _global_names(fn.__code__)
+    if "atan2" in names and not names & LIBM_CALLS:
+        return NUMBA_PRELUDE + FAST_ATAN2
+    return NUMBA_PRELUDE
 
 
 def xp_bindings(xp, dtype, device) -> dict:
