@@ -494,6 +494,11 @@ PARAM_SAMPLERS = {
         _euler_params(rng, True),
         [_quats(rng, n, span)],
     ),
+    # qmax: the largest accepted |q| (rows beyond it are flagged with middle angle 8)
+    "euler.euler_from_quat_checked": lambda rng, n, span: (
+        _euler_params(rng, True) + (1e70 if span == 300 else 1e8,),
+        [_quats(rng, n, span)],
+    ),
     "pose_formats.pose_distance": lambda rng, n, span: (
         (2.0, 0.5),  # rotation_weight, translation_weight
         [*_pose_pair(rng, n)],
@@ -601,7 +606,7 @@ def _np(x):
 
 #: Kernels whose outputs are angles: compared modulo 2 pi (pi and -pi are one angle,
 #: and rounding may land on either side of the cut).
-ANGLE_OUTPUTS = {"euler.euler_from_quat"}
+ANGLE_OUTPUTS = {"euler.euler_from_quat", "euler.euler_from_quat_checked"}
 
 
 def _close(got, ref, trails, what, tol=TOL, periodic=False):
@@ -798,6 +803,9 @@ SYMPY_SKIP = {
     "Piecewise compares NaN (its parts, normalize4 and quat_from_matrix, are checked)",
     "davenport.davenport_from_quat": "reduction to XYX through euler_from_quat over "
     "symbols: SymPy runs for over 15 s (quat_multiply and euler_from_quat are checked)",
+    "euler.euler_from_quat_checked": "euler_from_quat (checked here) with a range test "
+    "on |q| in front: over symbols SymPy meets a NaN comparison in the Piecewise; the "
+    "kernel exists to validate NumPy input in the loop's own pass",
     "kinematics_integration.se3_increment_rk4": "three nested se(3) brackets, then exp: "
     "SymPy takes ~3.5 s (so3_increment_rk4 and pose_from_twist are checked)",
 }

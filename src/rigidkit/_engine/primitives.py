@@ -235,7 +235,19 @@ def xp_bindings(xp, dtype, device) -> dict:
     def where(cond, a, b):
         if isinstance(cond, bool):
             return a if cond else b
-        return xp.where(cond, lift(a), lift(b))
+        a, b = lift(a), lift(b)
+        try:
+            return xp.where(cond, a, b)
+        except TypeError:
+            # A strict namespace (array-api-strict) refuses to promote a bool
+            # operand with a float one. Kernels use a comparison that is always
+            # False (``w < w``) as a zero of the inputs' own dtype: a literal 0.0
+            # would make numba compute a float32 loop in float64.
+            if a.dtype == xp.bool:
+                a = xp.astype(a, b.dtype)
+            if b.dtype == xp.bool:
+                b = xp.astype(b, a.dtype)
+            return xp.where(cond, a, b)
 
     return {
         "sqrt": unary(xp.sqrt),
@@ -261,7 +273,16 @@ def sympy_bindings() -> dict:
     """Primitives over SymPy expressions (``where`` becomes ``Piecewise``)."""
     import sympy as sp
 
+    def as_number(v):
+        # A comparison used as a typed zero or one (``w < w``, see xp_bindings).
+        if v is True or v is sp.true:
+            return sp.Integer(1)
+        if v is False or v is sp.false:
+            return sp.Integer(0)
+        return v
+
     def where(cond, a, b):
+        a, b = as_number(a), as_number(b)
         if cond is True or cond is sp.true:
             return a
         if cond is False or cond is sp.false:
