@@ -206,7 +206,8 @@ def _has_star_call(fn) -> bool:
 
 def module_source(kernel, bcast=()) -> str:
     fns = [*kernel.dependencies(), kernel]
-    parts = [numba_prelude([f.fn for f in fns])]  # with the fast atan2 where it pays
+    # With the fast atan2 where it pays (batch loops that numba can vectorise).
+    parts = [numba_prelude([f.fn for f in fns], batch=bcast != SINGLE)]
     nargs = len(kernel.params) + sum(_size(s) for s in kernel.inputs)
     # Inlined at numba-IR level, the kernel and its helpers fuse into the loop body
     # (LLVM alone does not inline across numba functions). Numba's inliner cannot

@@ -197,19 +197,20 @@ def _global_names(code) -> set:
     return names
 
 
-def numba_prelude(functions) -> str:
+def numba_prelude(functions, batch=True) -> str:
     """The prelude of a generated module holding the Python ``functions``.
 
     :data:`NUMBA_PRELUDE`, plus :data:`FAST_ATAN2` if they call ``atan2`` and no
-    other libm function (:data:`LIBM_CALLS`): only then can the loop be vectorised,
-    where the fast ``atan2`` is 8x libm's; in a scalar loop libm's is faster. Names
-    are read from the bytecode (no docstring or comment can match). Modules that do
-    not call ``atan2`` keep the plain prelude (and their numba disk cache).
+    other libm function (:data:`LIBM_CALLS`), in a batch loop (``batch``): only
+    then can the loop be vectorised, where the fast ``atan2`` is 8x libm's; in a
+    scalar loop, and in the one-element loop, libm's is faster. Names are read
+    from the bytecode (no docstring or comment can match). Modules that do not
+    call ``atan2`` keep the plain prelude (and their numba disk cache).
     """
     names = set()
     for fn in functions:
         names |= _global_names(fn.__code__)
-    if "atan2" in names and not names & LIBM_CALLS:
+    if batch and "atan2" in names and not names & LIBM_CALLS:
         return NUMBA_PRELUDE + FAST_ATAN2
     return NUMBA_PRELUDE
 
