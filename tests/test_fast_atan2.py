@@ -51,6 +51,7 @@ def test_the_loops_here_and_only_vectorisable_ones_get_the_fast_atan2():
         return sqrt(y * y + x * x)
 
     assert numba_prelude([_angle.fn]) == NUMBA_PRELUDE + FAST_ATAN2
+    assert numba_prelude([_angle.fn], batch=False) == NUMBA_PRELUDE  # one element
     assert numba_prelude([_angle.fn, with_sin]) == NUMBA_PRELUDE
     assert numba_prelude([with_nested_exp]) == NUMBA_PRELUDE
     assert numba_prelude([without_atan2]) == NUMBA_PRELUDE
