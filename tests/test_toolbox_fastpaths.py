@@ -61,3 +61,21 @@ def test_slerp_fraction_checks(rng):
     for bad in (np.nan, np.inf, np.array([0.5, np.nan, 0.1, 0.2, 0.3])):
         with pytest.raises(rk.NonFiniteError):
             rk.slerp(A, B, bad)
+
+
+def test_slerp_fraction_check_of_many_values(rng):
+    """Above 16 values t is checked by one isfinite pass: NaN or inf anywhere is
+    caught, with its index; finite t pass."""
+    q = rng.standard_normal((2, 40, 4))
+    A, B = rk.Rotation.from_quat(q[0]), rk.Rotation.from_quat(q[1])
+    for bad in (np.nan, np.inf, -np.inf):
+        t = rng.uniform(0.0, 1.0, (5, 8))
+        t[3, 6] = bad
+        with pytest.raises(rk.NonFiniteError) as err:
+            rk.slerp(A.reshape(5, 8), B.reshape(5, 8), t)
+        assert tuple(err.value.index) == (3, 6)
+    t = np.zeros(40)
+    t[1::2] = 1.0
+    out = rk.slerp(A, B, t).as_quat()
+    np.testing.assert_array_equal(out[::2], A.as_quat()[::2])
+    assert np.all(quat_angle(out[1::2], B.as_quat()[1::2]) < 1e-14)
