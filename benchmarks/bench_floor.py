@@ -42,6 +42,7 @@ def main() -> None:
     import quaternion  # numpy-quaternion
 
     import rigidkit as rk
+    from rigidkit._engine.dispatch import entry_point
     from rigidkit.functional import conversions as conv
 
     rng = np.random.default_rng(0)
@@ -56,8 +57,10 @@ def main() -> None:
             raise SystemExit("the compiled loops did not load within 60 s")
         time.sleep(0.2)
         big @ big, big.inv()
-    compose_loop = conv.quat_compose._ready[(False, False)][np.dtype(np.float64)]
-    conj_loop = conv.quat_conjugate._ready[(False,)][np.dtype(np.float64)]
+    # The compiled entry points, as the fast path calls them (no numba typing).
+    f64 = np.dtype(np.float64)
+    compose_loop = entry_point(conv.quat_compose._ready[(False, False)][f64])
+    conj_loop = entry_point(conv.quat_conjugate._ready[(False,)][f64])
 
     rows = []
     for n in args.sizes:
@@ -74,6 +77,71 @@ def main() -> None:
     headers = ["op", "N", *NAMES, "floor/np-quat"]
     print("us per call (median); floor = numba + empty + object")
     print(table(headers, rows, left=2))
+    print()
+    print(_matrix_floor(rk, args.repeat))
+
+
+def _matrix_floor(rk, repeat) -> str:
+    """SE(3) ``as_matrix``: scipy copies the 4x4 matrices it stores; we compute
+    them from poses (7 numbers). The floor of any loop that writes 16 doubles per
+    element with scalar stores (numba does not vectorise them): a loop that only
+    stores (the pose's 7 numbers copied and 9 constants, no arithmetic)."""
+    import numba
+    from scipy.spatial.transform import RigidTransform
+
+    @numba.njit(error_model="numpy", nogil=True)
+    def stores_only(p, out):
+        for i in range(p.shape[0]):
+            out[i, 0, 0] = p[i, 0]
+            out[i, 0, 1] = p[i, 1]
+            out[i, 0, 2] = p[i, 2]
+            out[i, 0, 3] = p[i, 4]
+            out[i, 1, 0] = p[i, 3]
+            out[i, 1, 1] = p[i, 0]
+            out[i, 1, 2] = p[i, 1]
+            out[i, 1, 3] = p[i, 5]
+            out[i, 2, 0] = p[i, 2]
+            out[i, 2, 1] = p[i, 3]
+            out[i, 2, 2] = p[i, 0]
+            out[i, 2, 3] = p[i, 6]
+            out[i, 3, 0] = 0.0
+            out[i, 3, 1] = 0.0
+            out[i, 3, 2] = 0.0
+            out[i, 3, 3] = 1.0
+
+    rng = np.random.default_rng(1)
+    rows = []
+    for n in (100, 1000, 10000):
+        T = rk.Transform.from_matrix(_random_matrices(rk, rng, n))
+        S = RigidTransform.from_matrix(T.as_matrix())
+        pose = T._pose  # the stored (n, 7) poses
+        stores_only(pose, np.empty((n, 4, 4)))
+        fns = {
+            "scipy (copy)": S.as_matrix,
+            "stores only + empty": lambda p=pose, n=n: stores_only(p, np.empty((n, 4, 4))),
+            "rigidkit": T.as_matrix,
+        }
+        res = interleaved_medians(fns, repeat=repeat)
+        us = {k: v["median"] * 1e6 for k, v in res.items()}
+        rows.append(
+            [
+                f"{n:,}",
+                *(fmt(us[k]) for k in fns),
+                f"{us['stores only + empty'] / us['scipy (copy)']:.2f}x",
+            ]
+        )
+    head = "SE(3) as_matrix, us per call (median)"
+    return head + "\n" + table(["N", *fns, "stores/scipy"], rows)
+
+
+def _random_matrices(rk, rng, n):
+    q = rng.standard_normal((n, 4))
+    R = rk.Rotation.from_quat(q).as_matrix()
+    M = np.zeros((n, 4, 4))
+    M[:, :3, :3] = R
+    M[:, :3, 3] = rng.standard_normal((n, 3))
+    M[:, 3, 3] = 1.0
+    return M
 
 
 NAMES = ("np-quat", "numba + empty", "numba + empty + object", "functional", "Rotation")

@@ -351,6 +351,33 @@ def check_rows(rows, libs, sizes=(1, 5)) -> dict:
     return bad
 
 
+def warm_rigidkit(rows, libs, ns=(1, 10, 3, 2000)) -> None:
+    """Call every rigidkit op, then wait for its compiled loops (as bench_curve does).
+
+    The steady state is timed: each op is called 100 times at one element (hot
+    kernels get their one-element loop) and once at a few batch sizes, twice
+    over, and the background thread's compiles are waited for. The first calls
+    of a fresh process are bench_curve's fresh-process section.
+    """
+    from rigidkit._engine import numba_backend
+
+    for _ in range(2):
+        for n in ns:
+            d = make_data(n, libs)
+            for r in rows:
+                if r.batched_only and d.single:
+                    continue
+                builder = r.impls.get("rigidkit")
+                fn = builder(d) if builder is not None else None
+                if fn is None:
+                    continue
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    for _ in range(100 if d.single else 1):
+                        fn()
+        numba_backend.drain(timeout=900)
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--sizes", type=int, nargs="+", default=[1, 1000, 10_000, 1_000_000])
@@ -378,6 +405,7 @@ def main(argv=None):
     checks = {} if args.no_check else check_rows(rows, libs)
     for (key, lib), msg in checks.items():
         print(f"CHECK {key} / {lib}: {msg}")
+    warm_rigidkit(rows, libs)
     record = {"sizes": {}}
     for n in args.sizes:
         d = make_data(n, libs)
