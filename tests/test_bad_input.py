@@ -67,6 +67,20 @@ def test_zero_quaternion():
     np.testing.assert_array_equal(R.as_quat(), [0.0, 1.0, 0.0, 0.0])
 
 
+def test_largest_quaternions_name_rotations():
+    """|q| above the largest float (its norm overflows) is a valid, finite input."""
+    big = np.finfo(np.float64).max
+    q = np.array([[big, big, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0], [0.0, -big, big, big]])
+    unit = C.quat_normalize(q)
+    h, t = np.sqrt(0.5), np.sqrt(1.0 / 3.0)
+    np.testing.assert_allclose(unit, [[h, h, 0, 0], [1, 0, 0, 0], [0, -t, t, t]], 1e-15)
+    np.testing.assert_allclose(C.quat_normalize(q[0]), unit[0], rtol=1e-15)
+    R = rk.Rotation.from_quat(q)
+    np.testing.assert_allclose(R.as_rotvec()[0], [np.pi / 2, 0, 0], rtol=1e-15)
+    q[1] = 0.0  # a zero row among them is still refused, with its index
+    _raises(rk.ZeroNormError, lambda: C.quat_normalize(q), "(1,)")
+
+
 @pytest.mark.needs("torch")
 def test_torch_quaternion_errors():
     q = torch.tensor(_batch_with_bad([1.0, 0, 0, 0], [np.nan, 0, 0, 0]))

@@ -119,8 +119,12 @@ def quat_normalize(q, *, what="quaternion"):
     ok = (norm > 0.0) & (norm < math.inf)
     if not all_true(ok):
         check_finite(q, (4,), what)
+        # Finite input: an infinite norm is |q| above the largest float (the unit
+        # quaternion, scaled by the largest component, is right); only zero fails.
         raise_unless(
-            ok, ZeroNormError, f"{what} has zero norm {{where}}; it names no rotation"
+            norm > 0.0,
+            ZeroNormError,
+            f"{what} has zero norm {{where}}; it names no rotation",
         )
     return unit
 
