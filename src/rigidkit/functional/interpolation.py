@@ -15,12 +15,10 @@ array([0.70710678, 0.        , 0.        , 0.70710678])
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from .._engine.namespace import namespace_of
-from .._validate import as_array, as_float, finite_array
+from .._validate import as_array, as_float, check_finite, finite_array
 from ..kernels import geodesic as _k
 from . import conversions as _conv
 
@@ -50,20 +48,18 @@ def _pose(p, what):
 
 def _fraction(t):
     """``t`` checked finite, as an array (float64 for integers)."""
+    if type(t) is float:
+        t = np.asarray(t)
     if type(t) is np.ndarray and t.dtype.kind == "f":
-        # One element or a few (slerp's common calls): a Python loop over the
-        # values costs less than the general check's ufunc calls (1.1 -> 0.4 us).
-        # More: one isfinite pass (1.3 us at N = 100; the general check's shape
-        # and dtype handling cost 2.2). (A dot product, 0.6 us, would warn on
-        # overflow for |t| > 1e154.)
-        if t.size <= 16:
-            if all(map(math.isfinite, t.ravel().tolist())):
-                return t
-        elif np.isfinite(t).all():
-            return t
-    elif type(t) is float and math.isfinite(t):
-        return np.asarray(t)
-    return as_float(finite_array(t, (), "interpolation parameter t"))
+        # A float array is already what the kernels take: only the finiteness
+        # check (the one of _validate, a Python sum for a few values), not
+        # as_array's conversions.
+        check_finite(t, (), _T_WHAT)
+        return t
+    return as_float(finite_array(t, (), _T_WHAT))
+
+
+_T_WHAT = "interpolation parameter t"
 
 
 def quat_power(q, t):
