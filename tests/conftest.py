@@ -117,6 +117,22 @@ def rng():
     return np.random.default_rng(20240607)
 
 
+def hamilton(a, b):
+    """Hamilton product of scalar-first quaternions (..., 4), written out by hand
+    (the tests' reference, independent of the kernels)."""
+    aw, ax, ay, az = np.moveaxis(a, -1, 0)
+    bw, bx, by, bz = np.moveaxis(b, -1, 0)
+    return np.stack(
+        [
+            aw * bw - ax * bx - ay * by - az * bz,
+            aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+        ],
+        axis=-1,
+    )
+
+
 def quat_angle(q1, q2):
     """Angle (radians) of the rotation between unit quaternions, in float64 NumPy.
 

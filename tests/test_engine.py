@@ -51,7 +51,7 @@ import pytest
 import sympy as sp
 
 import rigidkit.kernels
-from conftest import optional
+from conftest import hamilton, optional
 from rigidkit._engine import Kernel, numba_backend
 
 # The module (the package re-exports the decorator under the same name).
@@ -246,21 +246,6 @@ def _flag(rng):
     return int(rng.integers(2))
 
 
-def _qmul(p, q):
-    """Hamilton products of (n, 4) arrays, written out (the samplers' own)."""
-    w1, x1, y1, z1 = p.T
-    w2, x2, y2, z2 = q.T
-    return np.stack(
-        [
-            w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
-            w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-            w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-            w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
-        ],
-        axis=-1,
-    )
-
-
 def _axis_quat(axis, angle):
     return np.concatenate(
         [np.cos(angle / 2)[:, None], np.sin(angle / 2)[:, None] * axis], -1
@@ -298,7 +283,7 @@ def _davenport_quats(rng, n, reverse):
     t1, t3 = rng.uniform(-math.pi, math.pi, (2, n))
     t2 = lam + math.pi / 2 + rng.uniform(-math.pi / 2 + 0.3, math.pi / 2 - 0.3, n)
     q1, q2, q3 = _axis_quat(a, t1), _axis_quat(b, t2), _axis_quat(c, t3)
-    q = _qmul(_qmul(q3, q2), q1) if reverse else _qmul(_qmul(q1, q2), q3)
+    q = hamilton(hamilton(q3, q2), q1) if reverse else hamilton(hamilton(q1, q2), q3)
     return [q, a, b, c]
 
 
@@ -477,7 +462,7 @@ def _quat_rate(rng, n):
     """Quaternions of any scale and their rates (rotation plus a scale rate)."""
     q = _unit(rng, n, 4) * 10.0 ** rng.uniform(-3, 3, (n, 1))
     w = np.concatenate([np.zeros((n, 1)), rng.standard_normal((n, 3))], -1)
-    return [q, 0.5 * _qmul(w, q) + rng.standard_normal((n, 1)) * q]
+    return [q, 0.5 * hamilton(w, q) + rng.standard_normal((n, 1)) * q]
 
 
 def _normal(rng, n, *shapes):

@@ -16,6 +16,7 @@ import scipy.linalg
 from scipy.spatial import transform as _sst
 
 import rigidkit as rk
+from conftest import hamilton
 
 SciTf = getattr(_sst, "RigidTransform", None)  # scipy >= 1.16
 needs_scipy_tf = pytest.mark.skipif(SciTf is None, reason="scipy without RigidTransform")
@@ -28,21 +29,6 @@ except ImportError:  # pragma: no cover - optional peer
 @pytest.fixture
 def rng():
     return np.random.default_rng(20240610)
-
-
-def hamilton(a, b):
-    """Hamilton product of scalar-first quaternions (..., 4), written out."""
-    aw, ax, ay, az = np.moveaxis(a, -1, 0)
-    bw, bx, by, bz = np.moveaxis(b, -1, 0)
-    return np.stack(
-        [
-            aw * bw - ax * bx - ay * by - az * bz,
-            aw * bx + ax * bw + ay * bz - az * by,
-            aw * by - ax * bz + ay * bw + az * bx,
-            aw * bz + ax * by - ay * bx + az * bw,
-        ],
-        axis=-1,
-    )
 
 
 def dual_product(a, b):
