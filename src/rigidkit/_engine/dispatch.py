@@ -123,10 +123,10 @@ def _run_single(outs, args) -> list[str]:
     return _run_loop(outs, args, lambda s: repr(tuple(s)))
 
 
-def fast_source(kernel, has_single=False) -> str:
+def fast_source(kernel) -> str:
     """Source of ``fast(self, *params, *arrays, out=None, backend=None)``.
 
-    ``has_single``: the kernel can have a one-element loop (table ``E_single``).
+    Every kernel has a one-element loop (table ``E_single``, 0-d inputs included).
     """
     nparams = len(kernel.params)
     params = [f"p{k}" for k in range(nparams)]
@@ -137,8 +137,7 @@ def fast_source(kernel, has_single=False) -> str:
     general = f"self._call({', '.join(params + names)}, out=out, backend=backend)"
     L = []
     if params:  # the memos of _get_loop, one per ready-loop table
-        tables = ["E_single"] if has_single else []
-        tables.append(f"E{_tag(tuple(False for _ in ins))}")
+        tables = ["E_single", f"E{_tag(tuple(False for _ in ins))}"]
         if len(ins) > 1:
             tables += [
                 f"E{_tag(tuple(k == j for k in range(len(ins))))}" for j in range(len(ins))
@@ -157,22 +156,18 @@ def fast_source(kernel, has_single=False) -> str:
     # -- one element -------------------------------------------------------------
     single = " and ".join(f"s{k} == {tuple(t)!r}" for k, t in enumerate(ins))
     L.append(f"            if {single}:")
-    if has_single:
-        # The compiled one-element loop (once this kernel is hot at one element):
-        # ~0.2 us of call, less than packing Python floats into a new array. A
-        # loop in the table implies a float32 or float64 dtype.
-        lkey = _loop_key(params)
-        L += _get_loop("E_single", params, 16)
-        L.append("                if loop is None:")
-        L.append("                    if dt is not F64 and dt is not F32:")
-        L.append(f"                        return {general}")
-        L.append(f"                    self._single_seen({lkey})")
-        L.append("                else:  # its inputs may have any strides")
-        sargs = list(params) + names
-        L += ["                    " + x for x in _run_single(outs, sargs)]
-    else:
-        L.append("                if dt is not F64 and dt is not F32:")
-        L.append(f"                    return {general}")
+    # The compiled one-element loop (once this kernel is hot at one element):
+    # ~0.2 us of call, less than packing Python floats into a new array. A
+    # loop in the table implies a float32 or float64 dtype.
+    lkey = _loop_key(params)
+    L += _get_loop("E_single", params, 16)
+    L.append("                if loop is None:")
+    L.append("                    if dt is not F64 and dt is not F32:")
+    L.append(f"                        return {general}")
+    L.append(f"                    self._single_seen({lkey})")
+    L.append("                else:  # its inputs may have any strides")
+    sargs = list(params) + names
+    L += ["                    " + x for x in _run_single(outs, sargs)]
     call = list(params)
     for a, s in zip(names, ins):
         if len(s) == 0:

@@ -364,10 +364,8 @@ class Kernel(_Rebindable):
             env["E_" + "".join("b" if b else "n" for b in bcast)] = self._entry.setdefault(
                 bcast, {}
             )
-        single = numba_backend.has_single(self)
-        if single:
-            env["E_single"] = self._entry.setdefault(numba_backend.SINGLE, {})
-        src = fast_source(self, has_single=single)
+        env["E_single"] = self._entry.setdefault(numba_backend.SINGLE, {})
+        src = fast_source(self)
         exec(compile(src, f"<rigidkit fast {self.name}>", "exec"), env)
         return env["fast"]
 

@@ -123,17 +123,6 @@ def _single_source(kernel) -> str:
     return f"def loop({', '.join(args)}):\n" + "\n".join(pre + body) + "\n"
 
 
-def has_single(kernel) -> bool:
-    """Whether ``kernel`` can have a one-element loop: every kernel can.
-
-    A 0-d input (the ``t`` of a slerp, an angle) is read as ``A[()]`` and a 0-d
-    output written through its one-element reshape, so a call with a scalar
-    parameter array (``rk.slerp(a, b, 0.3)``) also takes the compiled loop
-    (~0.2 us) rather than Python floats (~3.4 us for a slerp).
-    """
-    return True
-
-
 def _loop_source(kernel, bcast=()) -> str:
     """The loop over the batch, on arrays of their natural shape.
 
