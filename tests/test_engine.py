@@ -1015,6 +1015,7 @@ def test_no_call_waits_for_a_compile(monkeypatch):
         "matrix.quat_from_matrix",
         "euler.euler_from_quat",
         "se3.pose_compose",
+        "geodesic.quat_slerp",  # a 0-d input (t), read as A[()]
     ],
 )
 @pytest.mark.parametrize("dtype", [np.float64, np.float32], ids=["f64", "f32"])
@@ -1028,7 +1029,10 @@ def test_one_element_loop_agrees(name, dtype):
     assert k._ready[numba_backend.SINGLE][key] is loop
     runs = []
     for i in range(30):
-        one = [np.ascontiguousarray(a[i]) for a in arrays]
+        # (ascontiguousarray would make a 0-d input 1-d: a batch of one)
+        one = [
+            np.ascontiguousarray(a[i]) if a.ndim > 1 else np.asarray(a[i]) for a in arrays
+        ]
         got = _tuple(k(*params, *one))
         want = k.python(*params, *[c for a in one for c in a.ravel().tolist()])
         flat = np.concatenate([np.ravel(g) for g in got])
