@@ -79,3 +79,40 @@ def test_slerp_fraction_check_of_many_values(rng):
     out = rk.slerp(A, B, t).as_quat()
     np.testing.assert_array_equal(out[::2], A.as_quat()[::2])
     assert np.all(quat_angle(out[1::2], B.as_quat()[1::2]) < 1e-14)
+
+
+@pytest.mark.parametrize("n", [None, 1, 10, 64, 65])
+def test_slerp_quick_fraction_check_keeps_every_error(n, rng):
+    """rk.slerp's inlined quick test of t (0-d: a float conversion; up to 64 values:
+    a Python sum) lets no NaN or inf through, reports its index, and does not
+    reject finite values whose sum overflows."""
+    shape = () if n is None else (n,)
+    q = rng.standard_normal((2,) + shape + (4,))
+    A, B = rk.Rotation.from_quat(q[0]), rk.Rotation.from_quat(q[1])
+    k = () if n is None else (n - 1,)
+    for bad in (np.nan, np.inf, -np.inf):
+        t = rng.uniform(0.0, 1.0, shape)
+        t[k] = bad
+        with pytest.raises(rk.NonFiniteError) as err:
+            rk.slerp(A, B, t)
+        assert tuple(err.value.index) == k
+        if n is None:  # a Python float takes its own path
+            with pytest.raises(rk.NonFiniteError):
+                rk.slerp(A, B, float(bad))
+        with rk.set_validation(False):  # unchecked: NaN propagates, no error
+            assert np.isnan(
+                rk.slerp(A, B, np.where(np.isfinite(t), t, np.nan)).as_quat()[k]
+            ).all()
+    t = np.full(shape, 1e308)  # finite; a sum of two overflows
+    got = rk.slerp(A, B, t).as_quat()
+    assert np.all(np.isfinite(got))
+    np.testing.assert_allclose(np.linalg.norm(got, axis=-1), 1.0, rtol=1e-14)
+    t = rng.uniform(-0.5, 1.5, shape)
+    sa = SR.from_quat(np.asarray(A.as_quat()), scalar_first=True)
+    sb = SR.from_quat(np.asarray(B.as_quat()), scalar_first=True)
+    ref = (sa * SR.from_rotvec((sa.inv() * sb).as_rotvec() * t[..., None])).as_quat(
+        scalar_first=True
+    )
+    assert np.all(quat_angle(rk.slerp(A, B, t).as_quat(), ref) < 1e-14)
+    if n is None:
+        assert np.all(quat_angle(rk.slerp(A, B, float(t)).as_quat(), ref) < 1e-14)
