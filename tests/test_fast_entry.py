@@ -157,3 +157,69 @@ def test_out_buffers(n):
         with pytest.raises((error, TypeError)):
             K.matrix_from_pose(x, out=buf)
         np.testing.assert_array_equal(buf, before, err_msg=label)
+
+
+def _loop_layouts(a):
+    """Views of ``a`` (n, *trail) that are and are not C-contiguous, as NumPy says."""
+    wide = np.repeat(a, 2, axis=-1)
+    return {
+        "contiguous": (a, True),
+        "batch strided": (np.repeat(a, 2, axis=0)[::2], False),
+        "trailing strided": (wide[..., ::2], False),
+        "fortran": (np.asfortranarray(a), False),
+        # Relaxed strides: the batch axis of a batch of one may have any stride.
+        "one row of a strided batch": (np.repeat(a, 3, axis=0)[::3][:1], True),
+        "empty strided": (np.repeat(a, 2, axis=0)[::2][:0], True),
+    }
+
+
+@pytest.mark.parametrize("dtype", DTYPES, ids=["f64", "f32"])
+def test_batch_loop_checks_its_inputs_strides(dtype):
+    """The batch loop refuses, untouched, an input that is not C-contiguous.
+
+    The fast entry passes inputs without asking NumPy for their layout; the loop
+    reads the strides that come with them and returns 1 (nothing written) unless
+    NumPy would call the array C-contiguous, so that the call takes the general
+    path. A (3, 4) input checks the inner axes; the results are checked against
+    products of matrices by scipy (``@`` of homogeneous 4x4s).
+    """
+    from rigidkit.kernels import homogeneous as H
+
+    for kern in (K.matrix_from_pose, H.affine_compose, K.pose_compose):
+        _ready(kern, dtype)
+    p = _poses(6, dtype, 4)
+    m = _scipy_matrix(p)
+    A = np.ascontiguousarray(m[:, :3, :], dtype=dtype)
+    loop_pose = K.matrix_from_pose._entry[(False,)][np.dtype(dtype)]
+    loop_affine = H.affine_compose._entry[(False, False)][np.dtype(dtype)]
+    for label, (x, contiguous) in _loop_layouts(p).items():
+        assert x.flags.c_contiguous == contiguous, label
+        out = np.full((len(x), 4, 4), np.nan, dtype)
+        assert loop_pose(x, out) == (0 if contiguous else 1), label
+        if contiguous:
+            np.testing.assert_allclose(out, _scipy_matrix(x), rtol=0, atol=_tol(dtype))
+        else:
+            assert np.isnan(out).all(), label
+        got = K.matrix_from_pose(x)  # through the fast entry, either way right
+        np.testing.assert_allclose(got, _scipy_matrix(x), rtol=0, atol=_tol(dtype))
+    for label, (x, contiguous) in _loop_layouts(A).items():
+        assert x.flags.c_contiguous == contiguous, label
+        n = len(x)
+        out = np.full((n, 3, 4), np.nan, dtype)
+        y = A[:n]
+        assert loop_affine(y, x, out) == (0 if contiguous else 1), label
+        if not contiguous:
+            assert np.isnan(out).all(), label
+        x4 = np.concatenate([x, np.broadcast_to(m[:n, 3:, :], (n, 1, 4))], axis=1)
+        want = (m[:n] @ x4.astype(np.float64))[:, :3, :]
+        got = H.affine_compose(y, x)
+        np.testing.assert_allclose(got, want, rtol=0, atol=8 * _tol(dtype), err_msg=label)
+    # A broadcast row: its one axis is checked too (a strided row goes the general way).
+    row = np.repeat(p[2], 2)[::2]
+    loop_row = K.pose_compose._entry[(True, False)][np.dtype(dtype)]
+    out = np.full((6, 7), np.nan, dtype)
+    assert loop_row(row, p, out) == 1 and np.isnan(out).all()
+    assert loop_row(p[2], p, out) == 0
+    np.testing.assert_allclose(
+        _scipy_matrix(K.pose_compose(row, p)), m[2] @ m, rtol=0, atol=4 * _tol(dtype)
+    )
