@@ -13,26 +13,35 @@ def matrix_entries_from_quat(w, x, y, z):
     one is, by ~2e-16) every entry is then off by ``d |R_ij|`` instead of ``2 d``,
     and the terms summed are at most 1 instead of 2. Measured against mpmath on
     the normalised input: <= 5e-16 instead of 1e-15.
+
+    Off the diagonal, ``2 (x y - w z)`` is computed as ``(2x) y - (2w) z``: the
+    same number (doubling is exact, short of overflow and subnormals), with 3
+    additions instead of 6 (LLVM writes ``2 a`` as ``a + a``), and additions are
+    what a batch loop waits on once its stores are vector stores (the loop of
+    SE(3) ``as_matrix``: -5% at N = 1e3-1e4).
     """
     ww = w * w
     xx = x * x
     yy = y * y
     zz = z * z
-    xy = x * y
-    xz = x * z
-    yz = y * z
-    wx = w * x
-    wy = w * y
-    wz = w * z
+    w2 = w + w
+    x2 = x + x
+    y2 = y + y
+    xy2 = x2 * y
+    xz2 = x2 * z
+    yz2 = y2 * z
+    wx2 = w2 * x
+    wy2 = w2 * y
+    wz2 = w2 * z
     return (
         (ww + xx) - (yy + zz),
-        2.0 * (xy - wz),
-        2.0 * (xz + wy),
-        2.0 * (xy + wz),
+        xy2 - wz2,
+        xz2 + wy2,
+        xy2 + wz2,
         (ww + yy) - (xx + zz),
-        2.0 * (yz - wx),
-        2.0 * (xz - wy),
-        2.0 * (yz + wx),
+        yz2 - wx2,
+        xz2 - wy2,
+        yz2 + wx2,
         (ww + zz) - (xx + yy),
     )
 
