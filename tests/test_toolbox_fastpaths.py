@@ -116,3 +116,38 @@ def test_slerp_quick_fraction_check_keeps_every_error(n, rng):
     assert np.all(quat_angle(rk.slerp(A, B, t).as_quat(), ref) < 1e-14)
     if n is None:
         assert np.all(quat_angle(rk.slerp(A, B, float(t)).as_quat(), ref) < 1e-14)
+
+
+@pytest.mark.parametrize("shape", [(), (10,)])
+@pytest.mark.parametrize("t", [0.3, 2, -1.5])
+def test_a_python_number_t_keeps_float32(shape, t, rng):
+    """A Python float or int t is weak, as in NumPy: float32 ends give float32
+    (slerp, power, pose slerp), equal to scipy's float64 geodesic within float32."""
+    from rigidkit.functional import interpolation as fi
+
+    q = rng.standard_normal((2,) + shape + (4,))
+    q /= np.linalg.norm(q, axis=-1, keepdims=True)
+    sa = SR.from_quat(q[0].reshape(-1, 4), scalar_first=True)
+    sb = SR.from_quat(q[1].reshape(-1, 4), scalar_first=True)
+    ref = (sa * SR.from_rotvec((sa.inv() * sb).as_rotvec() * t)).as_quat(scalar_first=True)
+    A, B = (rk.Rotation.from_quat(x.astype(np.float32)) for x in q)
+    got = rk.slerp(A, B, t).as_quat()
+    assert got.dtype == np.float32 and got.shape == shape + (4,)
+    assert np.all(quat_angle(got.reshape(-1, 4).astype(np.float64), ref) < 1e-5)
+    power = fi.quat_power(q[0].astype(np.float32), t)
+    ref_power = SR.from_rotvec(sa.as_rotvec() * t).as_quat(scalar_first=True)
+    assert power.dtype == np.float32
+    assert np.all(quat_angle(power.reshape(-1, 4).astype(np.float64), ref_power) < 1e-5)
+    poses = np.concatenate([q, rng.standard_normal((2,) + shape + (3,))], axis=-1)
+    p32 = poses.astype(np.float32)
+    assert fi.pose_slerp(p32[0], p32[1], t, decoupled=True).dtype == np.float32
+    assert fi.pose_power(p32[0], t).dtype == np.float32
+
+
+def test_a_python_number_t_keeps_torch_float32(torch, rng):
+    q = rng.standard_normal((2, 6, 4))
+    A, B = (rk.Rotation.from_quat(torch.tensor(x, dtype=torch.float32)) for x in q)
+    got = rk.slerp(A, B, 0.25).as_quat()
+    assert got.dtype == torch.float32
+    ref = rk.slerp(*(rk.Rotation.from_quat(x) for x in q), 0.25).as_quat()
+    assert np.all(quat_angle(got.double().numpy(), ref) < 1e-5)

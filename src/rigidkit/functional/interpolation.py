@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-from .._engine.namespace import namespace_of
+from .._engine.namespace import device_of, namespace_of
 from .._validate import as_array, as_float, check_finite, finite_array
 from ..kernels import geodesic as _k
 from . import conversions as _conv
@@ -48,10 +48,19 @@ def _pose(p, what):
     return namespace_of(p).concat([q, p[..., 4:]], axis=-1)
 
 
-def _fraction(t):
-    """``t`` checked finite, as an array (float64 for integers)."""
-    if type(t) is float:
-        t = np.asarray(t)
+def _fraction(t, like):
+    """``t`` checked finite, as an array (float64 for integers).
+
+    A Python number is weak, as in NumPy: it takes the dtype, namespace and device
+    of ``like`` (the ends), so float32 rotations stay float32 and the compiled loop
+    of their dtype serves them (a float64 ``t`` made the result float64, through
+    the general path: 40 us at N = 10 instead of 7).
+    """
+    if type(t) is float or type(t) is int:
+        check_finite(t, (), _T_WHAT)
+        if type(like) is np.ndarray:
+            return np.array(t, like.dtype if like.dtype.kind == "f" else np.float64)
+        return namespace_of(like).asarray(t, dtype=like.dtype, device=device_of(like))
     if type(t) is np.ndarray and t.dtype.kind == "f":
         # A float array is already what the kernels take: only the finiteness
         # check (the one of _validate, a Python sum for a few values), not
@@ -83,7 +92,8 @@ def quat_power(q, t):
     >>> np.round(quat_power([0.0, 0.0, 0.0, 1.0], 0.5), 12)   # half of a half turn
     array([0.70710678, 0.        , 0.        , 0.70710678])
     """
-    return _k.quat_power(_unit_quat(q, "quaternion"), _fraction(t))
+    u = _unit_quat(q, "quaternion")
+    return _k.quat_power(u, _fraction(t, u))
 
 
 def quat_slerp(q0, q1, t):
@@ -104,7 +114,7 @@ def quat_slerp(q0, q1, t):
     """
     a = _unit_quat(q0, "quaternion q0")
     b = _unit_quat(q1, "quaternion q1")
-    return _k.quat_slerp(a, b, _fraction(t))
+    return _k.quat_slerp(a, b, _fraction(t, a))
 
 
 def pose_power(pose, t):
@@ -119,7 +129,8 @@ def pose_power(pose, t):
     -------
     ndarray, shape (..., 7)
     """
-    return _k.pose_power(_pose(pose, "pose"), _fraction(t))
+    p = _pose(pose, "pose")
+    return _k.pose_power(p, _fraction(t, p))
 
 
 def pose_slerp(pose0, pose1, t, *, decoupled=False):
@@ -149,7 +160,7 @@ def pose_slerp(pose0, pose1, t, *, decoupled=False):
 
 def quat_power_unchecked(q, t):
     """:func:`quat_power` of a unit quaternion (not checked); ``t`` is checked."""
-    return _k.quat_power(q, _fraction(t))
+    return _k.quat_power(q, _fraction(t, q))
 
 
 def quat_slerp_unchecked(q0, q1, t):
@@ -168,9 +179,9 @@ def quat_slerp_unchecked(q0, q1, t):
         ):
             check_finite(t, (), _T_WHAT)
         return _slerp(q0, q1, t)
-    if type(t) is float and _isfinite(t):
-        return _slerp(q0, q1, np.array(t))
-    return _slerp(q0, q1, _fraction(t))
+    if type(t) is float and _isfinite(t) and type(q0) is _ndarray:
+        return _slerp(q0, q1, np.array(t, q0.dtype))
+    return _slerp(q0, q1, _fraction(t, q0))
 
 
 # Bound once: a global and an attribute lookup are ~40 ns of a ~1 us call.
@@ -181,13 +192,13 @@ _isfinite = math.isfinite
 
 def pose_power_unchecked(pose, t):
     """:func:`pose_power` of a valid pose (not checked); ``t`` is checked."""
-    return _k.pose_power(pose, _fraction(t))
+    return _k.pose_power(pose, _fraction(t, pose))
 
 
 def pose_slerp_unchecked(pose0, pose1, t, *, decoupled=False):
     """:func:`pose_slerp` of valid poses (not checked); ``t`` is checked."""
     kernel = _k.pose_slerp_decoupled if decoupled else _k.pose_slerp
-    return kernel(pose0, pose1, _fraction(t))
+    return kernel(pose0, pose1, _fraction(t, pose0))
 
 
 def segment_index(knots, times):
