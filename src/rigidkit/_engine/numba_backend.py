@@ -91,11 +91,15 @@ FLAT_MAX = 4
 
 
 #: Outputs wider than ``FLAT_MAX`` whose last axis is this long (4x4 and 3x4
-#: matrices) are written a row at a time, each row one vector store
-#: (:func:`.numba_stores.store_row`): numba writes a component at a time, and LLVM
-#: does not merge those stores. SE(3) ``Transform.as_matrix`` (16 stores per
-#: element), with the cheaper off-diagonal of ``matrix_entries_from_quat``:
-#: 4.7 -> 4.3 us at N = 1e3, 41 -> 38 us at 1e4 (scipy's copy: 3.5 and 32).
+#: matrices), in a loop that writes more numbers than it reads, are written a row
+#: at a time, each row one vector store (:func:`.numba_stores.store_row`): numba
+#: writes a component at a time, and LLVM does not merge those stores. Such a loop
+#: waits on its stores: SE(3) ``Transform.as_matrix`` (7 in, 16 out), with the
+#: cheaper off-diagonal of ``matrix_entries_from_quat``, 4.7 -> 4.3 us at N = 1e3,
+#: 41 -> 38 us at 1e4 (scipy's copy: 3.5 and 32); the loops of ``quat_left_matrix``
+#: and ``se3.hat`` -35%, ``sim3_matrix`` -10%. A loop that computes more than it
+#: stores waits on its arithmetic, and building the vectors costs it shuffles:
+#: ``projective_compose`` (32 in, 16 out) +5%, so it keeps scalar stores.
 ROW_STORE = 4
 
 
@@ -168,7 +172,7 @@ def _loop_source(kernel, bcast=()) -> str:
     for k, shape in enumerate(kernel.outputs):
         args.append(f"O{k}")
         w = _size(shape)
-        if _row_stores(shape):
+        if _row_stores(kernel, shape):
             pre.append(f"    o{k} = O{k}.reshape(O{k}.size)")
             for c in range(0, w, ROW_STORE):
                 row = ", ".join(f"r[{j + d}]" for d in range(ROW_STORE))
@@ -215,9 +219,15 @@ def _stride_tests(name, shape, batch=True) -> list[str]:
     return tests
 
 
-def _row_stores(shape) -> bool:
+def _row_stores(kernel, shape) -> bool:
     """True if a batch loop writes this output a row at a time (see ``ROW_STORE``)."""
-    return _size(shape) > FLAT_MAX and len(shape) > 0 and shape[-1] == ROW_STORE
+    w = _size(shape)
+    return (
+        w > FLAT_MAX
+        and len(shape) > 0
+        and shape[-1] == ROW_STORE
+        and w > sum(_size(s) for s in kernel.inputs)
+    )
 
 
 def _size(shape) -> int:
@@ -264,7 +274,7 @@ def module_source(kernel, bcast=()) -> str:
     for f in fns:
         parts.append("\n\n" + deco + "\n" + function_source(f.fn))
     loop = _single_source(kernel) if bcast == SINGLE else _loop_source(kernel, bcast)
-    if bcast != SINGLE and any(_row_stores(s) for s in kernel.outputs):
+    if bcast != SINGLE and any(_row_stores(kernel, s) for s in kernel.outputs):
         from .numba_stores import VERSION
 
         # The version is part of the source, hence of the module's name and cache.
