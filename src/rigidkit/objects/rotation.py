@@ -54,6 +54,7 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
     _trail = (4,)
     _identity = (1.0, 0.0, 0.0, 0.0)
     _compose_kernel = _conv.quat_compose
+    _inverse_kernel = _conv.quat_conjugate
     dof, matrix_size, point_dim = 3, 3, 3
 
     def __init__(self, quat, *, _normalized=False):
@@ -353,7 +354,7 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
 
     def inv(self):
         """Inverse rotations (conjugate quaternions)."""
-        return Rotation._wrap(_conv.quat_conjugate(self._quat))
+        return Rotation._wrap(self._inverse_kernel(self._quat))
 
     def approx_equal(self, other, *, atol=1e-8):
         """Elementwise: the angle between the rotations is at most ``atol`` (radians).

@@ -54,6 +54,7 @@ class Rotation2D(BatchedArray, LieGroup, family="plane", rank=0):
     _trail = (2,)
     _identity = (1.0, 0.0)  # (cos 0, sin 0)
     _compose_kernel = _k.complex_multiply
+    _inverse_kernel = _k.complex_conjugate
     dof, matrix_size, point_dim = 1, 2, 2
 
     def __init__(self, cos_sin):
@@ -173,7 +174,7 @@ class Rotation2D(BatchedArray, LieGroup, family="plane", rank=0):
 
     def inv(self):
         """Inverse rotations (conjugate complex numbers)."""
-        return Rotation2D._wrap(_k.complex_conjugate(self._data))
+        return Rotation2D._wrap(self._inverse_kernel(self._data))
 
     def approx_equal(self, other, *, atol=1e-8):
         """Elementwise: the angle between the rotations is at most ``atol`` (radians)."""

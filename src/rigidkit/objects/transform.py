@@ -66,6 +66,7 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
     _trail = (7,)
     _identity = (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)  # (w, x, y, z, tx, ty, tz)
     _compose_kernel = _k.pose_compose
+    _inverse_kernel = _k.pose_inv
     dof, matrix_size, point_dim = 6, 4, 3
 
     def __init__(self, rotation=None, translation=None):
@@ -279,7 +280,7 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
 
     def inv(self):
         """Inverse transforms ``[R^T, -R^T t]`` (closed form, no matrix inverse)."""
-        return Transform._wrap(_k.pose_inv(self._pose))
+        return Transform._wrap(self._inverse_kernel(self._pose))
 
     def approx_equal(self, other, *, atol=1e-8):
         """Elementwise: rotation angle between them and translation distance <= ``atol``.

@@ -59,6 +59,7 @@ class Transform2D(BatchedArray, LieGroup, family="plane", rank=1):
     _trail = (4,)
     _identity = (1.0, 0.0, 0.0, 0.0)  # (cos 0, sin 0, tx, ty)
     _compose_kernel = _k.pose_multiply
+    _inverse_kernel = _k.pose_inverse
     dof, matrix_size, point_dim = 3, 3, 2
 
     def __init__(self, rotation=None, translation=None):
@@ -160,7 +161,7 @@ class Transform2D(BatchedArray, LieGroup, family="plane", rank=1):
 
     def inv(self):
         """Inverse motions ``(R^T, -R^T t)``."""
-        return Transform2D._wrap(_k.pose_inverse(self._data))
+        return Transform2D._wrap(self._inverse_kernel(self._data))
 
     def approx_equal(self, other, *, atol=1e-8):
         """Elementwise: rotation angle between them and translation distance <= ``atol``."""
