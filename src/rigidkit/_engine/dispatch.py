@@ -201,6 +201,9 @@ def fast_source(kernel) -> str:
         conds = [] if j is None else [f"s{j} == {tuple(ins[j])!r}"]
         for k in others:
             t = ins[k]
+            if k != ref and t == ins[ref]:  # one tuple test for a shape already known
+                conds.append(f"s{k} == s{ref}")
+                continue
             conds.append(f"len(s{k}) == {1 + len(t)}")
             conds += [f"s{k}[{1 + d}] == {size}" for d, size in enumerate(t)]
             if k != ref:
