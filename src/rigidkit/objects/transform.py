@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._engine.dispatch import owned_env, owned_source
 from .._engine.namespace import device_of, namespace_of
 from .._validate import as_array, finite_array, to_numpy
 from ..functional import averaging as _avg
@@ -386,6 +387,34 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
         (array([1., 0., 0.]), array([0., 0., 1.]), 0.5, 1.0)
         """
         return _screw.screw_from_twist(self.log())
+
+
+def _owned_as_matrix(slow):
+    """``Transform.as_matrix`` from a NumPy pose batch straight to its compiled loop.
+
+    The method, the kernel's fast entry and its shape tests cost ~0.45 us of a
+    0.9 us call at N = 10 (scipy: 0.9 us), and ~0.4 us at N = 1e3; an object's
+    stored poses are known to be ``(..., 7)``, so :func:`.dispatch.owned_source`
+    tests only the type, dtype and rank. Anything else (``out=``, other
+    namespaces, N-D batches, a loop not loaded yet) calls ``slow``.
+    """
+    kernel = _k.matrix_from_pose
+    lines = [
+        "def as_matrix(self, *, out=None):",
+        "    if out is None:",
+        "        a0 = self._pose",
+    ]
+    lines += owned_source(kernel, ["a0"], ["return o0"], indent=8)
+    lines.append("    return slow(self, out=out)")
+    env = owned_env(kernel) | {"slow": slow}
+    exec(compile("\n".join(lines) + "\n", "<rigidkit Transform fast>", "exec"), env)
+    method = env["as_matrix"]
+    method.__qualname__ = "Transform.as_matrix"
+    method.__doc__, method.__wrapped__ = slow.__doc__, slow
+    return method
+
+
+Transform.as_matrix = _owned_as_matrix(Transform.as_matrix)
 
 
 def pose_gap(a, b):
