@@ -501,7 +501,11 @@ class Kernel(_Rebindable):
                 if n <= ROWS_MAX:
                     res = self._call_rows(params, arrays, batch, dtype, n)
                 else:
-                    res = self._call_xp(np, params, arrays, batch)
+                    # Standing in for the loop, which never warns: a kernel's
+                    # overflow into a branch that `where` discards is not the
+                    # caller's (slerp's sinc at t phi ~ 1e308).
+                    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+                        res = self._call_xp(np, params, arrays, batch)
                 return res if out is None else self._write_out(res, out)
         if backend == "python":
             return self._call_python(params, arrays, batch, dtype, out)
