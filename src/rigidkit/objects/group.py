@@ -64,11 +64,11 @@ class Group(ABC):
         if family is not None:
             ladder.register(cls, family, rank)
         if cls._compose_kernel is not None:
-            cls.__matmul__ = _owned_method(
+            cls.__matmul__ = owned_method(
                 cls, cls._compose_kernel, Group.__matmul__, "other"
             )
         if cls._inverse_kernel is not None:
-            cls.inv = _owned_method(cls, cls._inverse_kernel, cls.inv)
+            cls.inv = owned_method(cls, cls._inverse_kernel, cls.inv)
 
     # The kernel that composes two stored arrays of this kind; each kind sets it.
     _compose_kernel = None
@@ -225,31 +225,41 @@ def _no_mul(a, b) -> str:
     )
 
 
-def _owned_method(cls, kernel, slow, other=None):
-    """``cls``'s ``a @ b`` (``other`` names ``b``) or ``a.inv()``, fast where it counts.
+def owned_method(cls, kernel, slow, other=None, *, array=False, out=False):
+    """``cls``'s method ``slow`` made fast where it counts: ``a @ b``, ``a.inv()``, ...
 
-    ``a @ b`` of two NumPy batches of one kind and shape, and ``a.inv()``, go
-    from the operator straight to the kernel's compiled loop (see
-    :func:`.dispatch.owned_source`): these are the library's most frequent
-    calls, at N = 10 about 1 us in all, of which the method, the kernel's
-    entry and the new object are most. Anything else calls ``slow``, the method
-    written for the general case (whose docstring this one keeps).
+    For NumPy storage of one batch axis (or one element), and ``b`` of the same
+    kind and shape, the method goes from the call straight to the kernel's
+    compiled loop (see :func:`.dispatch.owned_source`): these are the library's
+    most frequent calls, at N = 10 about 1 us in all, of which the method, the
+    kernel's entry and the new object are most. Anything else calls ``slow``,
+    the method written for the general case (whose docstring this one keeps).
+
+    ``other``: the name of the second operand (``a @ b``), else None (``a.inv()``);
+    ``array``: the method returns the kernel's array (``as_matrix``), not an
+    object of ``cls``; ``out``: it takes ``out=`` (the fast path when it is None).
     """
-    shapes = [*kernel.inputs, *kernel.outputs]
-    if kernel.params or any(tuple(t) != tuple(cls._trail) for t in shapes):
+    kinds = [*kernel.inputs] + ([] if array else [*kernel.outputs])
+    if kernel.params or any(tuple(t) != tuple(cls._trail) for t in kinds):
         return slow  # not a kernel of this kind's stored arrays alone
     storage = "_data" if cls._storage == "_data" else f"_data = r.{cls._storage}"
-    result = ["r = new(CLS)", f"r.{storage} = o0", "return r"]
-    if other is None:
-        names, head, test = ["a0"], "def method(self):", []
-    else:
-        names, head = ["a0", "a1"], f"def method(self, {other}):"
-        test = [f"    if type({other}) is not CLS:", f"        return slow(self, {other})"]
-    lines = [head, *test, "    a0 = self._data"]
-    if other is not None:
-        lines.append(f"    a1 = {other}._data")
-    lines += owned_source(kernel, names, result, indent=4)
-    lines.append(f"    return slow(self{', ' + other if other else ''})")
+    result = ["return o0"] if array else ["r = new(CLS)", f"r.{storage} = o0", "return r"]
+    names = ["a0"] if other is None else ["a0", "a1"]
+    args = ["self"] + ([other] if other else [])
+    head = f"def method({', '.join(args)}{', *, out=None' if out else ''}):"
+    fallback = f"    return slow({', '.join(args)}{', out=out' if out else ''})"
+    lines = [head]
+    if other:
+        lines += [f"    if type({other}) is not CLS:", "    " + fallback]
+    pad = "    "
+    if out:
+        lines.append("    if out is None:")
+        pad = "        "
+    lines.append(pad + "a0 = self._data")
+    if other:
+        lines.append(pad + f"a1 = {other}._data")
+    lines += owned_source(kernel, names, result, indent=len(pad))
+    lines.append(fallback)
     env = owned_env(kernel) | {"CLS": cls, "new": object.__new__, "slow": slow}
     exec(compile("\n".join(lines) + "\n", f"<rigidkit {cls.__name__} fast>", "exec"), env)
     method = env["method"]
