@@ -281,6 +281,9 @@ class Kernel(_Rebindable):
         # The same loops' compiled entry points, for the fast path only (see
         # dispatch.entry_point): {broadcast pattern: {dtype: entry point}}.
         self._entry: dict = {}
+        # The loops that release the GIL, for batches split over threads (loaded
+        # only when such a batch comes, see numba_backend.loop_options).
+        self._threaded: dict = {}
         self._nsingle: dict = {}  # one-element calls counted per loop key
         _TORCH_KERNELS.add(self)
         if _TORCH_BOUND:
@@ -435,16 +438,20 @@ class Kernel(_Rebindable):
             k += m
         return self._finish(outs)
 
-    def _loop_ready(self, bcast, dtype, ints, loop):
+    def _loop_ready(self, bcast, dtype, ints, loop, nogil=False):
         """Called by the background loader when a compiled loop can be used.
 
         The table of a broadcast pattern is keyed by dtype, and for a kernel with
         parameters by ``(dtype, ints)`` (which parameters are integers, see
         :func:`_ints`): each combination is its own compiled signature.
+        ``nogil``: the variant for batches split over threads, kept apart.
         """
         from .dispatch import entry_point
 
         key = (dtype, ints) if self.params else dtype
+        if nogil:
+            self._threaded.setdefault(bcast, {})[key] = loop
+            return
         self._entry.setdefault(bcast, {})[key] = entry_point(loop)
         self._ready.setdefault(bcast, {})[key] = loop
 
@@ -595,7 +602,18 @@ class Kernel(_Rebindable):
                 raise RuntimeError(f"{self.name}: numba is not available")
             loop = numba_backend.wait(self, bcast, dtype, ints)
         oargs = [o.reshape((n,) + s) for o, s in zip(outs, self.outputs)]
-        numba_backend.run_loop(loop, n, list(params), ins, bcast, oargs)
+        workers = numba_backend.workers(n)
+        if workers > 1:
+            key = (dtype, ints) if params else dtype
+            threaded = self._threaded.get(bcast, {}).get(key)
+            if (
+                threaded is None
+            ):  # asked for now, for the next batch: this one on one thread
+                numba_backend.request(self, bcast, dtype, ints, nogil=True)
+                workers = 1
+            else:
+                loop = threaded
+        numba_backend.run_loop(loop, n, list(params), ins, bcast, oargs, workers)
         return self._finish(outs)
 
     # -- any array namespace --------------------------------------------------

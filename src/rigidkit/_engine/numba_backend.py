@@ -257,7 +257,7 @@ def _has_star_call(fn) -> bool:
     return star(fn.__code__)
 
 
-def module_source(kernel, bcast=()) -> str:
+def module_source(kernel, bcast=(), nogil=False) -> str:
     fns = [*kernel.dependencies(), kernel]
     # With the fast atan2 where it pays (batch loops that numba can vectorise).
     parts = [numba_prelude([f.fn for f in fns], batch=bcast != SINGLE)]
@@ -284,13 +284,13 @@ def module_source(kernel, bcast=()) -> str:
     parts.append("\n\n" + loop)
     # numba's disk cache is keyed by the source, not by the options: a loop cached
     # with other options must not be taken for this one.
-    parts.append(f"\n# compiled with {sorted(loop_options(bcast).items())!r}\n")
+    parts.append(f"\n# compiled with {sorted(loop_options(nogil).items())!r}\n")
     return "\n".join(parts)
 
 
-def _module(kernel, bcast):
+def _module(kernel, bcast, nogil=False):
     """Import the generated module of ``kernel`` for broadcast pattern ``bcast``."""
-    src = module_source(kernel, bcast)
+    src = module_source(kernel, bcast, nogil)
     return import_source(
         f"rigidkit_k_{kernel.name}", src, f"<rigidkit kernel {kernel.name}>"
     )
@@ -361,29 +361,33 @@ def signature(kernel, bcast, dtype, ints=()):
     return types.int64(*args)
 
 
-def compile_loop(kernel, bcast, dtype, ints=()):
+def compile_loop(kernel, bcast, dtype, ints=(), nogil=False):
     """The compiled loop of ``kernel`` (from the disk cache when it is there).
 
     One dispatcher per dtype and broadcast pattern, compiled for its single
-    :func:`signature` only, with further compiles disabled.
+    :func:`signature` only, with further compiles disabled; ``nogil``: the
+    variant that releases the GIL, for a batch split over threads.
     """
     import numba
 
-    module, cache = _module(kernel, bcast)
+    module, cache = _module(kernel, bcast, nogil)
     sig = signature(kernel, bcast, dtype, ints)
-    return numba.njit([sig], cache=cache, **loop_options(bcast))(module.loop)
+    return numba.njit([sig], cache=cache, **loop_options(nogil))(module.loop)
 
 
-def loop_options(bcast) -> dict:
+def loop_options(nogil=False) -> dict:
     """The options a loop is compiled with (also written into its module's source).
 
     A loop allocates nothing, so it needs no NRT (numba's reference counting):
     without it a call unboxes each array without allocating a meminfo for it,
-    ~0.1 us less per call (SE(3) compose at one element 1.23 -> 1.04 us). Batch
-    loops release the GIL (``nogil``: large batches are split over threads); the
-    one-element loop keeps it, which saves ~0.04 us more.
+    ~0.1 us less per call (SE(3) compose at one element 1.23 -> 1.04 us). Loops
+    keep the GIL: releasing and taking it back costs ~35 ns a call (compose at
+    N = 10: 0.20 vs 0.17 us for the loop's call), which only a batch split over
+    threads (``nogil=True``, at least ``PARALLEL_MIN`` long, see
+    :func:`run_loop`) gets back. That variant is compiled when such a batch
+    first comes, in the background; until it is ready, batches run on one thread.
     """
-    return {"nogil": bcast != SINGLE, "error_model": "numpy", "_nrt": False}
+    return {"nogil": nogil, "error_model": "numpy", "_nrt": False}
 
 
 # -- the background loader ---------------------------------------------------------
@@ -393,26 +397,38 @@ _THREAD = None
 
 
 class _Job:
-    __slots__ = ("kernel", "bcast", "dtype", "ints", "build", "done", "loop", "error")
+    __slots__ = (
+        "kernel",
+        "bcast",
+        "dtype",
+        "ints",
+        "nogil",
+        "build",
+        "done",
+        "loop",
+        "error",
+    )
 
-    def __init__(self, kernel, bcast, dtype, ints, build=None):
+    def __init__(self, kernel, bcast, dtype, ints, build=None, nogil=False):
         self.kernel, self.bcast, self.dtype, self.ints = kernel, bcast, dtype, ints
+        self.nogil = nogil
         self.build = build
         self.done = threading.Event()
         self.loop = None
         self.error = None
 
 
-def request(kernel, bcast, dtype, ints=()) -> _Job:
+def request(kernel, bcast, dtype, ints=(), nogil=False) -> _Job:
     """Queue the loop of ``kernel`` for the background thread (once per key).
 
-    When it is ready the thread calls ``kernel._loop_ready(bcast, dtype, ints, loop)``.
+    When it is ready the thread calls ``kernel._loop_ready(bcast, dtype, ints,
+    loop, nogil)``; ``nogil``: the variant for threads (see :func:`loop_options`).
     """
-    key = (id(kernel), bcast, dtype.char, ints)
+    key = (id(kernel), bcast, dtype.char, ints, nogil)
     job = _PENDING.get(key)
     if job is not None:
         return job
-    return _submit(key, lambda: _Job(kernel, bcast, dtype, ints))
+    return _submit(key, lambda: _Job(kernel, bcast, dtype, ints, nogil=nogil))
 
 
 def request_build(key, build) -> _Job:
@@ -450,9 +466,9 @@ def _submit(key, make) -> _Job:
     return job
 
 
-def wait(kernel, bcast, dtype, ints=()):
+def wait(kernel, bcast, dtype, ints=(), nogil=False):
     """The loop of ``kernel``, blocking until the background thread has it."""
-    job = request(kernel, bcast, dtype, ints)
+    job = request(kernel, bcast, dtype, ints, nogil)
     job.done.wait()
     if job.error is not None:
         raise job.error
@@ -491,8 +507,10 @@ def _work():
             if job.build is not None:
                 job.loop = job.build()
             else:
-                job.loop = compile_loop(job.kernel, job.bcast, job.dtype, job.ints)
-                job.kernel._loop_ready(job.bcast, job.dtype, job.ints, job.loop)
+                job.loop = compile_loop(
+                    job.kernel, job.bcast, job.dtype, job.ints, job.nogil
+                )
+                job.kernel._loop_ready(job.bcast, job.dtype, job.ints, job.loop, job.nogil)
         except BaseException as exc:  # noqa: BLE001 - handed to whoever waits
             job.error = exc
         job.done.set()
@@ -532,13 +550,18 @@ def _workers() -> int:
     return max(1, min(n, int(n - others + 0.5)))
 
 
-def run_loop(loop, n, params, ins, bcast, outs):
-    """Run ``loop(*params, *ins, *outs)``, split over threads if it pays.
+def workers(n) -> int:
+    """How many threads a batch of ``n`` is split over (1 below ``PARALLEL_MIN``)."""
+    return 1 if n < PARALLEL_MIN else _workers()
+
+
+def run_loop(loop, n, params, ins, bcast, outs, workers=1):
+    """Run ``loop(*params, *ins, *outs)``, split over ``workers`` threads.
 
     ``ins``/``outs`` are ``(n, ...)`` arrays, except the inputs flagged in
-    ``bcast`` (one row for the whole batch). Each thread gets views of its rows.
+    ``bcast`` (one row for the whole batch). Each thread gets views of its rows;
+    with more than one, ``loop`` must be the variant that releases the GIL.
     """
-    workers = 1 if n < PARALLEL_MIN else _workers()
     if workers < 2:
         loop(*params, *ins, *outs)
         return
