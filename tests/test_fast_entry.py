@@ -253,3 +253,20 @@ def test_threaded_batches_take_the_loop_that_releases_the_gil(monkeypatch):
     # The first batch: on one thread, unless an earlier test had the variant loaded.
     assert len(runs) == 2 and runs[0] in [(plain, 1), (threaded, 2)]
     assert runs[1] == (threaded, 2)
+
+
+def test_general_path_never_takes_a_refusal_for_a_result():
+    """The general path makes its inputs C-contiguous, so a loop's refusal there
+    (status 1) is a bug of ours: it raises instead of returning unwritten outputs."""
+    kern = K.matrix_from_pose
+    loop = numba_backend.wait(kern, (False,), np.dtype(np.float64))
+    p = _poses(4, np.float64, 6)
+    out = np.full((4, 4, 4), np.nan)
+    numba_backend.run_loop(loop, 4, [], [p], (False,), [out])
+    np.testing.assert_allclose(out, _scipy_matrix(p), rtol=0, atol=_tol(np.float64))
+    # What the general path never passes (its dispatcher would refuse the type;
+    # the entry point, which does not type its arguments, returns status 1).
+    strided = np.repeat(p, 2, axis=0)[::2]
+    entry = kern._entry[(False,)][np.dtype(np.float64)]
+    with pytest.raises(RuntimeError, match="refused"):
+        numba_backend.run_loop(entry, 4, [], [strided], (False,), [out])

@@ -563,7 +563,7 @@ def run_loop(loop, n, params, ins, bcast, outs, workers=1):
     with more than one, ``loop`` must be the variant that releases the GIL.
     """
     if workers < 2:
-        loop(*params, *ins, *outs)
+        _ran(loop(*params, *ins, *outs))
         return
 
     def chunk(start, stop):
@@ -576,9 +576,16 @@ def run_loop(loop, n, params, ins, bcast, outs, workers=1):
     futures = [
         _pool().submit(loop, *chunk(bounds[k], bounds[k + 1])) for k in range(1, workers)
     ]
-    loop(*chunk(bounds[0], bounds[1]))
+    _ran(loop(*chunk(bounds[0], bounds[1])))
     for f in futures:
-        f.result()
+        _ran(f.result())
+
+
+def _ran(status):
+    """A loop's status on arrays made C-contiguous: 0 (1 would be our bug, not the
+    caller's: outputs left unwritten must never pass for results)."""
+    if status:
+        raise RuntimeError(f"a compiled loop refused C-contiguous inputs (status {status})")
 
 
 def precompile(kernels, dtypes=("float64", "float32"), verbose=False) -> int:
