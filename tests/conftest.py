@@ -25,6 +25,8 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, settings
 
+import rigidkit as rk
+
 settings.register_profile(
     "default",
     max_examples=100,
@@ -115,6 +117,18 @@ dask_array = _backend_fixture("dask_array")
 def rng():
     """A seeded generator, fresh for every test (tests stay independent of order)."""
     return np.random.default_rng(20240607)
+
+
+# Every kind of transform (objects.group.Group), for tests run once per kind.
+GROUP_KINDS = [
+    rk.Rotation,
+    rk.Transform,
+    rk.Rotation2D,
+    rk.Transform2D,
+    rk.Similarity,
+    rk.Affine,
+    rk.Projective,
+]
 
 
 def hamilton(a, b):

@@ -22,18 +22,10 @@ import numpy as np
 import pytest
 
 import rigidkit as rk
+from conftest import GROUP_KINDS
 from rigidkit.objects._batch import BatchedArray
 
-CLASSES = [
-    rk.Rotation,
-    rk.Transform,
-    rk.Rotation2D,
-    rk.Transform2D,
-    rk.Similarity,
-    rk.Affine,
-    rk.Projective,
-    rk.Quaternion,
-]
+CLASSES = [*GROUP_KINDS, rk.Quaternion]
 
 
 def sample(cls, shape):

@@ -14,19 +14,12 @@ import numpy as np
 import pytest
 
 import rigidkit as rk
+from conftest import GROUP_KINDS
 from rigidkit._engine import numba_backend
 
 pytestmark = pytest.mark.skipif(not numba_backend.available(), reason="needs numba")
 
-KINDS = [
-    rk.Rotation,
-    rk.Transform,
-    rk.Rotation2D,
-    rk.Transform2D,
-    rk.Similarity,
-    rk.Affine,
-    rk.Projective,
-]
+KINDS = GROUP_KINDS
 
 
 def _ready(cls, dtype):

@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 import rigidkit as rk
+from conftest import GROUP_KINDS
 from rigidkit import conversions, euler, kinematics, quaternion, se2, se3, so2, so3
 
 R_ = rk.Rotation
@@ -642,7 +643,7 @@ def test_half_precision_keeps_dtype(name, data):
 
 # -- identity and random in any namespace --------------------------------------------------
 
-CLASSES = [R_, T_, rk.Rotation2D, rk.Transform2D, rk.Similarity, rk.Affine, rk.Projective]
+CLASSES = GROUP_KINDS
 
 
 @pytest.mark.parametrize("cls", CLASSES, ids=lambda c: c.__name__)
