@@ -606,9 +606,8 @@ class Kernel(_Rebindable):
         if workers > 1:
             key = (dtype, ints) if params else dtype
             threaded = self._threaded.get(bcast, {}).get(key)
-            if (
-                threaded is None
-            ):  # asked for now, for the next batch: this one on one thread
+            if threaded is None:
+                # Asked for now, for the next batch; this one runs on one thread.
                 numba_backend.request(self, bcast, dtype, ints, nogil=True)
                 workers = 1
             else:

@@ -156,12 +156,11 @@ def _loop_source(kernel, bcast=()) -> str:
         w = _size(shape)
         if k < len(bcast) and bcast[k]:
             strided += _stride_tests(f"A{k}", (w,), batch=False)
-        else:
-            strided += _stride_tests(f"A{k}", shape)
-        if k < len(bcast) and bcast[k]:
             pre += [f"    b{k}_{c} = A{k}[{c}]" for c in range(w)]
             call += [f"b{k}_{c}" for c in range(w)]
-        elif w <= FLAT_MAX:
+            continue
+        strided += _stride_tests(f"A{k}", shape)
+        if w <= FLAT_MAX:
             pre.append(f"    a{k} = A{k}.reshape(A{k}.size)")
             call += [f"a{k}[{w} * i + {c}]" for c in range(w)]
         else:
