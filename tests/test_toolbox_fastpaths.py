@@ -83,9 +83,9 @@ def test_slerp_fraction_check_of_many_values(rng):
 
 @pytest.mark.parametrize("n", [None, 1, 10, 64, 65])
 def test_slerp_quick_fraction_check_keeps_every_error(n, rng):
-    """rk.slerp's inlined quick test of t (0-d: a float conversion; up to 64 values:
-    a Python sum) lets no NaN or inf through, reports its index, and does not
-    reject finite values whose sum overflows."""
+    """The quick test of t that rk.slerp takes (check_finite's: 0-d, a float
+    conversion; up to 64 values, a Python sum) lets no NaN or inf through, reports
+    its index, and does not reject finite values whose sum overflows."""
     shape = () if n is None else (n,)
     q = rng.standard_normal((2,) + shape + (4,))
     A, B = rk.Rotation.from_quat(q[0]), rk.Rotation.from_quat(q[1])

@@ -15,8 +15,6 @@ array([0.70710678, 0.        , 0.        , 0.70710678])
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from .._engine.namespace import device_of, namespace_of
@@ -165,29 +163,7 @@ def quat_power_unchecked(q, t):
 
 def quat_slerp_unchecked(q0, q1, t):
     """:func:`quat_slerp` of unit quaternions (not checked); ``t`` is checked."""
-    # rk.slerp's common call, a float array t, in one frame: _fraction's first
-    # test inlined (a Python frame is ~10% of a one-element slerp), and a finite
-    # t of one batch axis passed by check_finite's quick test inlined (a 0-d t: one
-    # float conversion, 50 ns; a few: one Python sum, where a NaN or inf stays
-    # non-finite and an overflow only sends us on): its call costs ~0.2 us.
-    if type(t) is _ndarray and t.dtype.kind == "f":
-        nd = t.ndim
-        if not (
-            _isfinite(t)
-            if nd == 0
-            else nd == 1 and len(t) <= 64 and _isfinite(sum(t.tolist()))
-        ):
-            check_finite(t, (), _T_WHAT)
-        return _slerp(q0, q1, t)
-    if type(t) is float and _isfinite(t) and type(q0) is _ndarray:
-        return _slerp(q0, q1, np.array(t, q0.dtype))
-    return _slerp(q0, q1, _fraction(t, q0))
-
-
-# Bound once: a global and an attribute lookup are ~40 ns of a ~1 us call.
-_slerp = _k.quat_slerp
-_ndarray = np.ndarray
-_isfinite = math.isfinite
+    return _k.quat_slerp(q0, q1, _fraction(t, q0))
 
 
 def pose_power_unchecked(pose, t):
