@@ -140,7 +140,17 @@ def test_a_python_number_t_keeps_float32(shape, t, rng):
     assert np.all(quat_angle(power.reshape(-1, 4).astype(np.float64), ref_power) < 1e-5)
     poses = np.concatenate([q, rng.standard_normal((2,) + shape + (3,))], axis=-1)
     p32 = poses.astype(np.float32)
-    assert fi.pose_slerp(p32[0], p32[1], t, decoupled=True).dtype == np.float32
+    mid = fi.pose_slerp(p32[0], p32[1], t, decoupled=True)
+    assert mid.dtype == np.float32
+    # decoupled: the rotations' geodesic, and the straight line between translations
+    assert np.all(quat_angle(mid[..., :4].reshape(-1, 4).astype(np.float64), ref) < 1e-5)
+    line = (1.0 - t) * poses[0, ..., 4:] + t * poses[1, ..., 4:]
+    np.testing.assert_allclose(
+        mid[..., 4:],
+        line,
+        rtol=0,
+        atol=8 * np.finfo(np.float32).eps * (1 + 2 * abs(t)) * np.abs(poses).max(),
+    )
     assert fi.pose_power(p32[0], t).dtype == np.float32
 
 
@@ -149,5 +159,9 @@ def test_a_python_number_t_keeps_torch_float32(torch, rng):
     A, B = (rk.Rotation.from_quat(torch.tensor(x, dtype=torch.float32)) for x in q)
     got = rk.slerp(A, B, 0.25).as_quat()
     assert got.dtype == torch.float32
-    ref = rk.slerp(*(rk.Rotation.from_quat(x) for x in q), 0.25).as_quat()
+    sa = SR.from_quat(q[0], scalar_first=True)
+    sb = SR.from_quat(q[1], scalar_first=True)
+    ref = (sa * SR.from_rotvec((sa.inv() * sb).as_rotvec() * 0.25)).as_quat(
+        scalar_first=True
+    )
     assert np.all(quat_angle(got.double().numpy(), ref) < 1e-5)
