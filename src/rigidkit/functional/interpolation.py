@@ -54,17 +54,17 @@ def _fraction(t, like):
     of their dtype serves them (a float64 ``t`` made the result float64, through
     the general path: 40 us at N = 10 instead of 7).
     """
-    if type(t) is float or type(t) is int:
-        check_finite(t, (), _T_WHAT)
-        if type(like) is np.ndarray:
-            return np.array(t, like.dtype if like.dtype.kind == "f" else np.float64)
-        return namespace_of(like).asarray(t, dtype=like.dtype, device=device_of(like))
-    if type(t) is np.ndarray and t.dtype.kind == "f":
+    if type(t) is np.ndarray and t.dtype.kind == "f":  # the common call, first
         # A float array is already what the kernels take: only the finiteness
         # check (the one of _validate, a Python sum for a few values), not
         # as_array's conversions.
         check_finite(t, (), _T_WHAT)
         return t
+    if type(t) is float or type(t) is int:
+        check_finite(t, (), _T_WHAT)
+        if type(like) is np.ndarray:
+            return np.array(t, like.dtype if like.dtype.kind == "f" else np.float64)
+        return namespace_of(like).asarray(t, dtype=like.dtype, device=device_of(like))
     return as_float(finite_array(t, (), _T_WHAT))
 
 
