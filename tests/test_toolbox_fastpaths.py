@@ -165,3 +165,73 @@ def test_a_python_number_t_keeps_torch_float32(torch, rng):
         scalar_first=True
     )
     assert np.all(quat_angle(got.double().numpy(), ref) < 1e-5)
+
+
+def _ready_slerp(dtype):
+    """The loops rk.slerp's own path calls (batch and one element), compiled."""
+    from rigidkit._engine import numba_backend
+    from rigidkit.kernels import geodesic
+
+    if not numba_backend.available():
+        pytest.skip("numba is not available")
+    for pattern in ((False, False, False), numba_backend.SINGLE):
+        numba_backend.wait(geodesic.quat_slerp, pattern, np.dtype(dtype))
+
+
+def _scipy_slerp(qa, qb, t):
+    sa = SR.from_quat(np.asarray(qa, np.float64).reshape(-1, 4), scalar_first=True)
+    sb = SR.from_quat(np.asarray(qb, np.float64).reshape(-1, 4), scalar_first=True)
+    rv = (sa.inv() * sb).as_rotvec() * np.reshape(t, (-1, 1))
+    return (sa * SR.from_rotvec(rv)).as_quat(scalar_first=True)
+
+
+@pytest.mark.parametrize("dtype, tol", [(np.float64, 1e-14), (np.float32, 2e-6)])
+@pytest.mark.parametrize("n", [None, 1, 10, 17, 1000])
+def test_slerp_straight_to_its_loop(n, dtype, tol, rng):
+    """Two NumPy batches and a t array of theirs go from rk.slerp to the compiled
+    loop (its vectorised sin, cos, atan2): the geodesic of scipy, a new array,
+    every non-finite t reported with its index, and a t beyond the fast sine's
+    range (t phi > 2^19) computed again, still on the geodesic."""
+    _ready_slerp(dtype)
+    shape = () if n is None else (n,)
+    q = rng.standard_normal((2,) + shape + (4,)).astype(dtype)
+    A, B = rk.Rotation.from_quat(q[0]), rk.Rotation.from_quat(q[1])
+    t = rng.uniform(-0.5, 1.5, shape).astype(dtype)
+    got = rk.slerp(A, B, t)
+    out = got.as_quat()
+    assert out.dtype == dtype and out.shape == shape + (4,)
+    assert np.all(quat_angle(out.reshape(-1, 4), _scipy_slerp(q[0], q[1], t)) < tol)
+    for stored in (A._quat, B._quat, t):
+        assert not np.shares_memory(got._quat, stored)
+    k = () if n is None else (n // 2,)
+    for bad in (np.nan, np.inf, -np.inf):
+        tb = t.copy()
+        tb[k] = bad
+        with pytest.raises(rk.NonFiniteError) as err:
+            rk.slerp(A, B, tb)
+        assert tuple(err.value.index) == k
+    # Far beyond [0, 1]: |t phi| > 2^19 where the angle is not tiny.
+    big = np.full(shape, dtype(3e6))
+    far = rk.slerp(A, B, big).as_quat()
+    ref = _scipy_slerp(q[0], q[1], big)
+    # The angle t theta (up to 3e6 pi ~ 1e7 rad) is rounded in both, each to a few
+    # ulp of itself: the geodesic to that precision.
+    assert np.all(
+        quat_angle(far.reshape(-1, 4), ref) < 3e6 * np.pi * 8 * np.finfo(dtype).eps
+    )
+
+
+def test_slerp_of_other_layouts_and_dtypes_takes_the_general_path(rng):
+    """A strided t, a t of another dtype, or ends of two batch shapes: the same
+    geodesic through the general path."""
+    _ready_slerp(np.float64)
+    q = rng.standard_normal((2, 12, 4))
+    A, B = rk.Rotation.from_quat(q[0]), rk.Rotation.from_quat(q[1])
+    t = rng.uniform(0.0, 1.0, 24)
+    ref = _scipy_slerp(q[0], q[1], t[::2])
+    for tt in (t[::2], t[::2].astype(np.float32), t[::2].tolist()):
+        assert np.all(quat_angle(rk.slerp(A, B, tt).as_quat(), ref) < 1e-6)
+    row = rk.slerp(A[:1], B, t[::2]).as_quat()
+    assert np.all(
+        quat_angle(row, _scipy_slerp(np.repeat(q[0, :1], 12, 0), q[1], t[::2])) < 1e-14
+    )

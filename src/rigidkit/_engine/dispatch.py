@@ -259,41 +259,61 @@ def _run_batch(outs, args) -> list[str]:
     return _run_loop(outs, args, _shape_n, status=True)
 
 
-def owned_source(kernel, names, result, indent=8) -> list[str]:
+def owned_source(kernel, names, result, indent=8, user=()) -> list[str]:
     """Lines that run ``kernel`` on arrays an object owns, straight to its loops.
 
-    For the generated methods of objects (``a @ b``, ``a.inv()``): ``names`` are
-    the variables holding the kernel's input arrays (no static parameters), each
-    known to have the kernel's input shape after its batch axes (an object's
-    stored array always has its kind's trailing shape), so that of the fast
-    entry's checks only the exact ``ndarray`` type, the dtype and the batch
-    shapes are left: all inputs of one batch shape, one batch axis or none.
-    When the loop ran, ``result`` (lines that may read the output ``o0``) ends
-    the method; otherwise these lines fall through, and the method goes on to
-    call the kernel (its fast entry, or the general path). Runs in the
-    namespace of :func:`owned_env`. Saves the kernel call's own frame and its
-    shape tests, ~0.3 us of a 1 us ``a @ b`` at N = 10.
+    For the generated methods of objects (``a @ b``, ``a.inv()``) and functions
+    of them (``rk.slerp``): ``names`` are the variables holding the kernel's
+    input arrays (no static parameters). Each is known to have the kernel's
+    input shape after its batch axes (an object's stored array always has its
+    kind's trailing shape), except those also named in ``user``: arrays of the
+    caller's, of trailing shape ``()`` here (slerp's ``t``), whose shape is tested
+    in full and whose finiteness is tested too. So of the fast entry's checks
+    only the exact ``ndarray`` type, the dtype and the batch shapes are left:
+    all inputs of one batch shape, one batch axis or none. When the loop ran,
+    ``result`` (lines that may read the output ``o0``) ends the method;
+    otherwise these lines fall through, and the method goes on to call the
+    kernel (its fast entry, or the general path). Runs in the namespace of
+    :func:`owned_env`. Saves the kernel call's own frame and its shape tests,
+    ~0.3 us of a 1 us ``a @ b`` at N = 10.
+
+    A ``user`` array's finiteness: in a batch the loop tests it, so only a
+    ``vector_math`` kernel may have one (its loop's status 2, see
+    :func:`.numba_backend._loop_source`); the one-element loop reports nothing,
+    so these lines test it (``isfinite``).
     """
     (out,) = kernel.outputs
-    if kernel.params or any(s != kernel.inputs[0] for s in kernel.inputs):
-        raise ValueError(f"{kernel.name}: owned_source takes one input shape, no params")
+    ins = kernel.inputs
+    shared = [k for k, b in enumerate(names) if b not in user]
+    if kernel.params or any(ins[k] != ins[0] for k in shared) or not shared[0] == 0:
+        raise ValueError(f"{kernel.name}: owned_source takes one object shape, no params")
+    if any(ins[k] != () for k, b in enumerate(names) if b in user) or (
+        user and not kernel.vector_math
+    ):
+        raise ValueError(
+            f"{kernel.name}: user arrays are of shape (), in vector_math kernels"
+        )
     pad = " " * indent
-    rank = len(kernel.inputs[0])
+    rank = len(ins[0])
     a = names[0]
     batch_out = "(" + ", ".join(["s[0]", *map(str, out)]) + ("," if not out else "") + ")"
-    same = [f"{b}.shape == s" for b in names[1:]] + [f"{b}.dtype is dt" for b in names[1:]]
+    same = [f"{names[k]}.shape == s" for k in shared[1:]]
+    batch = [f"{b}.shape == s[:1]" for b in names if b in user]
+    single = [f"{b}.shape == ()" for b in names if b in user]
+    single += [f"isfinite({b})" for b in names if b in user]
+    same += [f"{b}.dtype is dt" for b in names[1:]]
     lines = [
         f"if {' and '.join(f'type({b}) is ndarray' for b in names)}:",
         f"    s = {a}.shape",
         f"    dt = {a}.dtype",
         f"    if {' and '.join(same) or 'True'}:",
-        f"        if len(s) == {rank + 1}:",
+        f"        if len(s) == {rank + 1}{''.join(' and ' + c for c in batch)}:",
         "            loop = E_batch.get(dt)",
         "            if loop is not None and s[0] < PMIN and K.BINDING is None:",
-        f"                o0 = empty({'s' if out == kernel.inputs[0] else batch_out}, dt)",
+        f"                o0 = empty({'s' if out == ins[0] else batch_out}, dt)",
         f"                if not loop({', '.join(names)}, o0):",
         *["                    " + x for x in result],
-        f"        elif len(s) == {rank}:",
+        f"        elif len(s) == {rank}{''.join(' and ' + c for c in single)}:",
         "            loop = E_single.get(dt)",
         "            if loop is not None:",
         f"                o0 = empty({tuple(out)!r}, dt)",
@@ -314,6 +334,7 @@ def owned_env(kernel) -> dict:
     return {
         "ndarray": np.ndarray,
         "empty": np.empty,
+        "isfinite": math.isfinite,
         "PMIN": numba_backend.PARALLEL_MIN,
         "K": sys.modules[__package__ + ".kernel"],  # its BINDING, read at each call
         "E_batch": kernel._entry.setdefault((False,) * len(kernel.inputs), {}),

@@ -266,11 +266,12 @@ def helper(fn=None, *, numerical=False):
 class Kernel(_Rebindable):
     """A scalar formula bound to numba loops, array namespaces, floats and SymPy."""
 
-    def __init__(self, fn, inputs, outputs, params=()):
+    def __init__(self, fn, inputs, outputs, params=(), vector_math=False):
         super().__init__(fn)
         self.inputs = [tuple(s) for s in inputs]
         self.outputs = [tuple(s) for s in outputs]
         self.params = tuple(params)
+        self.vector_math = vector_math
         self._py = None
         self._sym = None
         self._xp_cache: dict = {}
@@ -612,7 +613,13 @@ class Kernel(_Rebindable):
                 workers = 1
             else:
                 loop = threaded
-        numba_backend.run_loop(loop, n, list(params), ins, bcast, oargs, workers)
+        if numba_backend.run_loop(loop, n, list(params), ins, bcast, oargs, workers):
+            # A vector_math loop met a non-finite input or result (a NaN of its
+            # fast sine beyond 2^19 among them): computed again with NumPy's libm.
+            with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+                res = self._call_xp(np, params, arrays, batch)
+            for o, r in zip(outs, [res] if len(self.outputs) == 1 else res):
+                o[...] = r
         return self._finish(outs)
 
     # -- any array namespace --------------------------------------------------
@@ -681,7 +688,7 @@ def _ints(params) -> tuple:
     return tuple(isinstance(p, _INTS) for p in params)
 
 
-def kernel(inputs, outputs, params=()):
+def kernel(inputs, outputs, params=(), vector_math=False):
     """Declare a kernel: trailing shapes of its array inputs and outputs.
 
     Parameters
@@ -690,10 +697,17 @@ def kernel(inputs, outputs, params=()):
         Trailing shape of each array argument / result, e.g. ``[(4,), (3,)]``.
     params : sequence of str
         Names of leading static arguments (Python numbers, same for the batch).
+    vector_math : bool
+        Its batch loops use the engine's own branch-free ``sin``, ``cos`` and
+        ``atan2`` (:data:`.primitives.FAST_SINCOS`), so that LLVM vectorises them
+        whole; the kernel may call no other libm function. Such a loop reports a
+        non-finite input or result (status 2), and that call is computed again by
+        NumPy: the fast ``sin`` and ``cos`` give NaN beyond ``|x| = 2^19``. For
+        kernels whose cost is their sines and cosines, measured before choosing.
     """
 
     def wrap(fn):
         _refuse_redefinition(fn)
-        return Kernel(fn, inputs, outputs, params)
+        return Kernel(fn, inputs, outputs, params, vector_math)
 
     return wrap

@@ -186,6 +186,16 @@ def _loop_source(kernel, bcast=()) -> str:
             target = f"o{k}[{w} * i + {c}]" if w <= FLAT_MAX else f"o{k}[i, {c}]"
             body.append(f"        {target} = r[{j}]")
             j += 1
+    done = "    return 0"
+    if kernel.vector_math:
+        # Status 2 if any input or result is not finite, a NaN of the fast sin and
+        # cos among them (|x| > 2^19): one sum an element, which a NaN or an
+        # infinity keeps non-finite (a sum that overflows only costs a recompute).
+        # The or-reduction of a flag vectorises; an early exit would not.
+        terms = call[nparams:] + [f"r[{k}]" for k in range(j)]
+        body += [f"        v = {' + '.join(terms)}", "        bad |= v - v != 0.0"]
+        pre.append("    bad = False")
+        done = "    return 2 if bad else 0"
     if strided:  # not C-contiguous: status 1, nothing read or written
         pre[1:1] = [
             "    if n > 0:",
@@ -193,7 +203,7 @@ def _loop_source(kernel, bcast=()) -> str:
             "            return 1",
         ]
     head = f"def loop({', '.join(args)}):\n"
-    lines = pre + ["    for i in range(n):"] + body + ["    return 0"]
+    lines = pre + ["    for i in range(n):"] + body + [done]
     return head + "\n".join(lines) + "\n"
 
 
@@ -259,7 +269,11 @@ def _has_star_call(fn) -> bool:
 def module_source(kernel, bcast=(), nogil=False) -> str:
     fns = [*kernel.dependencies(), kernel]
     # With the fast atan2 where it pays (batch loops that numba can vectorise).
-    parts = [numba_prelude([f.fn for f in fns], batch=bcast != SINGLE)]
+    parts = [
+        numba_prelude(
+            [f.fn for f in fns], batch=bcast != SINGLE, vector_math=kernel.vector_math
+        )
+    ]
     nargs = len(kernel.params) + sum(_size(s) for s in kernel.inputs)
     # Inlined at numba-IR level, the kernel and its helpers fuse into the loop body
     # (LLVM alone does not inline across numba functions). Numba's inliner cannot
@@ -555,15 +569,15 @@ def workers(n) -> int:
 
 
 def run_loop(loop, n, params, ins, bcast, outs, workers=1):
-    """Run ``loop(*params, *ins, *outs)``, split over ``workers`` threads.
+    """Run ``loop(*params, *ins, *outs)``, split over ``workers`` threads; returns
+    its status (see :func:`_ran`).
 
     ``ins``/``outs`` are ``(n, ...)`` arrays, except the inputs flagged in
     ``bcast`` (one row for the whole batch). Each thread gets views of its rows;
     with more than one, ``loop`` must be the variant that releases the GIL.
     """
     if workers < 2:
-        _ran(loop(*params, *ins, *outs))
-        return
+        return _ran(loop(*params, *ins, *outs))
 
     def chunk(start, stop):
         args = list(params)
@@ -575,16 +589,20 @@ def run_loop(loop, n, params, ins, bcast, outs, workers=1):
     futures = [
         _pool().submit(loop, *chunk(bounds[k], bounds[k + 1])) for k in range(1, workers)
     ]
-    _ran(loop(*chunk(bounds[0], bounds[1])))
+    status = _ran(loop(*chunk(bounds[0], bounds[1])))
     for f in futures:
-        _ran(f.result())
+        status = max(status, _ran(f.result()))
+    return status
 
 
 def _ran(status):
-    """A loop's status on arrays made C-contiguous: 0 (1 would be our bug, not the
-    caller's: outputs left unwritten must never pass for results)."""
-    if status:
-        raise RuntimeError(f"a compiled loop refused C-contiguous inputs (status {status})")
+    """A loop's status on arrays made C-contiguous, returned: 0, or 2 (a non-finite
+    input or result of a ``vector_math`` loop: the caller computes the call again).
+    1 would be our bug, not the caller's: outputs left unwritten must never pass
+    for results."""
+    if status == 1:
+        raise RuntimeError("a compiled loop refused C-contiguous inputs (status 1)")
+    return status
 
 
 def precompile(kernels, dtypes=("float64", "float32"), verbose=False) -> int:

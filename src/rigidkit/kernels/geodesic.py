@@ -44,7 +44,7 @@ def quat_power_entries(w, x, y, z, t):
     return (c, s * x, s * y, s * z)
 
 
-@kernel(inputs=[(4,), ()], outputs=[(4,)])
+@kernel(inputs=[(4,), ()], outputs=[(4,)], vector_math=True)
 def quat_power(w, x, y, z, t):
     """Power ``q^t`` of a unit quaternion: the rotation by ``t`` times its angle.
 
@@ -63,7 +63,7 @@ def quat_slerp_entries(w0, x0, y0, z0, w1, x1, y1, z1, t):
     return quat_multiply(w0, x0, y0, z0, pw, px, py, pz)
 
 
-@kernel(inputs=[(4,), (4,), ()], outputs=[(4,)])
+@kernel(inputs=[(4,), (4,), ()], outputs=[(4,)], vector_math=True)
 def quat_slerp(w0, x0, y0, z0, w1, x1, y1, z1, t):
     """Spherical linear interpolation ``q0 (q0* q1)^t`` of unit quaternions.
 
@@ -97,7 +97,7 @@ def pose_slerp(w0, x0, y0, z0, a0, b0, c0, w1, x1, y1, z1, a1, b1, c1, t):
     return pose_compose(w0, x0, y0, z0, a0, b0, c0, pw, px, py, pz, pa, pb, pc)
 
 
-@kernel(inputs=[(7,), (7,), ()], outputs=[(7,)])
+@kernel(inputs=[(7,), (7,), ()], outputs=[(7,)], vector_math=True)
 def pose_slerp_decoupled(w0, x0, y0, z0, a0, b0, c0, w1, x1, y1, z1, a1, b1, c1, t):
     """Rotation by slerp, translation linearly: ``(1 - t) t0 + t t1`` (exact at 0, 1)."""
     w, x, y, z = quat_slerp_entries(w0, x0, y0, z0, w1, x1, y1, z1, t)
