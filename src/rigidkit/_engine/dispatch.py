@@ -267,8 +267,9 @@ def owned_source(kernel, names, result, indent=8, user=()) -> list[str]:
     input arrays (no static parameters). Each is known to have the kernel's
     input shape after its batch axes (an object's stored array always has its
     kind's trailing shape), except those also named in ``user``: arrays of the
-    caller's, of trailing shape ``()`` here (slerp's ``t``), whose shape is tested
-    in full and whose finiteness is tested too. So of the fast entry's checks
+    caller's, of trailing shape ``()`` here (slerp's ``t``), whose number of
+    dimensions is tested here, its length and strides by the loop (status 1),
+    and its finiteness too (below). So of the fast entry's checks
     only the exact ``ndarray`` type, the dtype and the batch shapes are left:
     all inputs of one batch shape, one batch axis or none. When the loop ran,
     ``result`` (lines that may read the output ``o0``) ends the method;
@@ -297,23 +298,28 @@ def owned_source(kernel, names, result, indent=8, user=()) -> list[str]:
     rank = len(ins[0])
     a = names[0]
     batch_out = "(" + ", ".join(["s[0]", *map(str, out)]) + ("," if not out else "") + ")"
-    same = [f"{names[k]}.shape == s" for k in shared[1:]]
-    batch = [f"{b}.shape == s[:1]" for b in names if b in user]
-    single = [f"{b}.shape == ()" for b in names if b in user]
-    single += [f"isfinite({b})" for b in names if b in user]
-    same += [f"{b}.dtype is dt" for b in names[1:]]
+    mine = [names[k] for k in shared]
+    theirs = [b for b in names if b in user]
+    # Chained tests (``type(a0) is ndarray is type(a1)``): each operand once, ~20%
+    # of these lines' cost at N = 10. A user array's length is its loop's to test
+    # (status 1), as its strides are.
+    types = " is ".join([f"type({a}) is ndarray"] + [f"type({b})" for b in names[1:]])
+    same = [" is ".join(["dt"] + [f"{b}.dtype" for b in names[1:]])] if names[1:] else []
+    same += [f"{b}.shape == s" for b in mine[1:]]
+    batch = "".join(f" and {b}.ndim == 1" for b in theirs)
+    single = "".join(f" and {b}.ndim == 0 and isfinite({b})" for b in theirs)
     lines = [
-        f"if {' and '.join(f'type({b}) is ndarray' for b in names)}:",
-        f"    s = {a}.shape",
+        f"if {types}:",
         f"    dt = {a}.dtype",
+        f"    s = {a}.shape",
         f"    if {' and '.join(same) or 'True'}:",
-        f"        if len(s) == {rank + 1}{''.join(' and ' + c for c in batch)}:",
+        f"        if len(s) == {rank + 1}{batch}:",
         "            loop = E_batch.get(dt)",
         "            if loop is not None and s[0] < PMIN and K.BINDING is None:",
         f"                o0 = empty({'s' if out == ins[0] else batch_out}, dt)",
         f"                if not loop({', '.join(names)}, o0):",
         *["                    " + x for x in result],
-        f"        elif len(s) == {rank}{''.join(' and ' + c for c in single)}:",
+        f"        elif len(s) == {rank}{single}:",
         "            loop = E_single.get(dt)",
         "            if loop is not None:",
         f"                o0 = empty({tuple(out)!r}, dt)",

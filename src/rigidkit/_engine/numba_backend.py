@@ -159,7 +159,9 @@ def _loop_source(kernel, bcast=()) -> str:
             pre += [f"    b{k}_{c} = A{k}[{c}]" for c in range(w)]
             call += [f"b{k}_{c}" for c in range(w)]
             continue
-        strided += _stride_tests(f"A{k}", shape)
+        # Its length too: a generated function may pass a caller's array whose
+        # length it has not tested (dispatch.owned_source's user arrays).
+        strided += [f"A{k}.shape[0] != n", *_stride_tests(f"A{k}", shape)]
         if w <= FLAT_MAX:
             pre.append(f"    a{k} = A{k}.reshape(A{k}.size)")
             call += [f"a{k}[{w} * i + {c}]" for c in range(w)]
@@ -196,7 +198,7 @@ def _loop_source(kernel, bcast=()) -> str:
         body += [f"        v = {' + '.join(terms)}", "        bad |= v - v != 0.0"]
         pre.append("    bad = False")
         done = "    return 2 if bad else 0"
-    if strided:  # not C-contiguous: status 1, nothing read or written
+    if strided:  # not C-contiguous, or short: status 1, nothing read or written
         pre[1:1] = [
             "    if n > 0:",
             f"        if {' or '.join(strided)}:",

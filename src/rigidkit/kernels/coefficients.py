@@ -24,7 +24,7 @@ def sinc(x):
     small = abs(x) < 0.03
     series = 1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0))
     safe = where(small, 1.0, x)
-    return where(small, series, sin(safe) / safe)
+    return where(small, series, sin(x) / safe)
 
 
 @helper(numerical=True)
