@@ -83,11 +83,10 @@ def _owned_slerp(general):
     result = ["r = new(CLS)", "r._quat = r._data = o0", "return r"]  # Rotation._wrap
     lines = [
         "def slerp(a, b, t, *, decoupled=False):",
-        "    if type(a) is CLS and type(b) is CLS and not decoupled:",
+        "    if type(a) is CLS is type(b) and not decoupled:",
         "        a0 = a._quat",
         "        a1 = b._quat",
-        "        a2 = t",
-        *owned_source(kernel, ["a0", "a1", "a2"], result, 8, user=("a2",)),
+        *owned_source(kernel, ["a0", "a1", "t"], result, 8, user=("t",)),
         "    return general(a, b, t, decoupled=decoupled)",
     ]
     env = owned_env(kernel) | {"CLS": Rotation, "new": object.__new__, "general": general}
