@@ -235,3 +235,19 @@ def test_slerp_of_other_layouts_and_dtypes_takes_the_general_path(rng):
     assert np.all(
         quat_angle(row, _scipy_slerp(np.repeat(q[0, :1], 12, 0), q[1], t[::2])) < 1e-14
     )
+
+
+def test_slerp_of_one_fraction_or_one_pair_broadcasts(rng):
+    """A t of one value for many pairs, or one pair for many t: the lengths differ,
+    the loop refuses them (status 1) and the general path broadcasts."""
+    _ready_slerp(np.float64)
+    q = rng.standard_normal((2, 6, 4))
+    A, B = rk.Rotation.from_quat(q[0]), rk.Rotation.from_quat(q[1])
+    t = rng.uniform(0.0, 1.0, 6)
+    got = rk.slerp(A, B, t[:1]).as_quat()
+    assert got.shape == (6, 4)
+    assert np.all(quat_angle(got, _scipy_slerp(q[0], q[1], np.repeat(t[:1], 6))) < 1e-14)
+    got = rk.slerp(A[:1], B[:1], t).as_quat()
+    assert got.shape == (6, 4)
+    ref = _scipy_slerp(np.repeat(q[0, :1], 6, 0), np.repeat(q[1, :1], 6, 0), t)
+    assert np.all(quat_angle(got, ref) < 1e-14)
