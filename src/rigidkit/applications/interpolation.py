@@ -12,11 +12,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._engine.dispatch import owned_env, owned_source
+from .._engine.dispatch import owned_source
 from .._validate import finite_array, to_numpy
 from ..errors import DegenerateInputError, OutOfRangeError, ShapeError
 from ..functional import interpolation as _fi
 from ..kernels import geodesic as _kg
+from ..objects.group import compile_owned, new_object_lines
 from ..objects.rotation import Rotation
 from ..objects.transform import Transform
 
@@ -80,21 +81,16 @@ def _owned_slerp(general):
     checks ``t`` itself and raises for a non-finite one with its batch index.
     """
     kernel = _kg.quat_slerp
-    result = ["r = new(CLS)", "r._quat = r._data = o0", "return r"]  # Rotation._wrap
+    result = new_object_lines(Rotation)
     lines = [
         "def slerp(a, b, t, *, decoupled=False):",
         "    if type(a) is CLS is type(b) and not decoupled:",
         "        a0 = a._quat",
         "        a1 = b._quat",
         *owned_source(kernel, ["a0", "a1", "t"], result, 8, user=("t",)),
-        "    return general(a, b, t, decoupled=decoupled)",
+        "    return slow(a, b, t, decoupled=decoupled)",
     ]
-    env = owned_env(kernel) | {"CLS": Rotation, "new": object.__new__, "general": general}
-    exec(compile("\n".join(lines) + "\n", "<rigidkit slerp fast>", "exec"), env)
-    fast = env["slerp"]
-    fast.__doc__, fast.__wrapped__ = general.__doc__, general
-    fast.__module__, fast.__qualname__ = general.__module__, general.__qualname__
-    return fast
+    return compile_owned(lines, "slerp", kernel, Rotation, general, general.__qualname__)
 
 
 slerp = _owned_slerp(slerp)

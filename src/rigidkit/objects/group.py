@@ -242,8 +242,7 @@ def owned_method(cls, kernel, slow, other=None, *, array=False, out=False):
     kinds = [*kernel.inputs] + ([] if array else [*kernel.outputs])
     if kernel.params or any(tuple(t) != tuple(cls._trail) for t in kinds):
         return slow  # not a kernel of this kind's stored arrays alone
-    storage = "_data" if cls._storage == "_data" else f"_data = r.{cls._storage}"
-    result = ["return o0"] if array else ["r = new(CLS)", f"r.{storage} = o0", "return r"]
+    result = ["return o0"] if array else new_object_lines(cls)
     names = ["a0"] if other is None else ["a0", "a1"]
     args = ["self"] + ([other] if other else [])
     head = f"def method({', '.join(args)}{', *, out=None' if out else ''}):"
@@ -260,9 +259,24 @@ def owned_method(cls, kernel, slow, other=None, *, array=False, out=False):
         lines.append(pad + f"a1 = {other}._data")
     lines += owned_source(kernel, names, result, indent=len(pad))
     lines.append(fallback)
+    qualname = f"{cls.__name__}.{slow.__name__}"
+    return compile_owned(lines, "method", kernel, cls, slow, qualname)
+
+
+def new_object_lines(cls) -> list[str]:
+    """Lines that return a new ``cls`` holding the loop's output ``o0`` (its
+    ``_wrap`` inlined: the array under ``_data`` and the class's own slot name)."""
+    storage = "_data" if cls._storage == "_data" else f"_data = r.{cls._storage}"
+    return ["r = new(CLS)", f"r.{storage} = o0", "return r"]
+
+
+def compile_owned(lines, name, kernel, cls, slow, qualname):
+    """The function ``name`` that ``lines`` define, in :func:`.dispatch.owned_env`'s
+    namespace plus ``CLS``, ``new`` and ``slow`` (the general function, whose
+    docstring, module and name it takes; ``__wrapped__`` points to it)."""
     env = owned_env(kernel) | {"CLS": cls, "new": object.__new__, "slow": slow}
-    exec(compile("\n".join(lines) + "\n", f"<rigidkit {cls.__name__} fast>", "exec"), env)
-    method = env["method"]
-    method.__name__, method.__qualname__ = slow.__name__, f"{cls.__name__}.{slow.__name__}"
-    method.__doc__, method.__wrapped__ = slow.__doc__, slow
-    return method
+    exec(compile("\n".join(lines) + "\n", f"<rigidkit {qualname} fast>", "exec"), env)
+    fn = env[name]
+    fn.__name__, fn.__qualname__, fn.__module__ = slow.__name__, qualname, slow.__module__
+    fn.__doc__, fn.__wrapped__ = slow.__doc__, slow
+    return fn
