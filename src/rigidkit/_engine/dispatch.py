@@ -286,7 +286,7 @@ def owned_source(kernel, names, result, indent=8, user=()) -> list[str]:
     (out,) = kernel.outputs
     ins = kernel.inputs
     shared = [k for k, b in enumerate(names) if b not in user]
-    if kernel.params or any(ins[k] != ins[0] for k in shared) or not shared[0] == 0:
+    if kernel.params or any(ins[k] != ins[0] for k in shared) or shared[0] != 0:
         raise ValueError(f"{kernel.name}: owned_source takes one object shape, no params")
     if any(ins[k] != () for k, b in enumerate(names) if b in user) or (
         user and not kernel.vector_math

@@ -24,6 +24,9 @@ def sinc(x):
     small = abs(x) < 0.03
     series = 1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0))
     safe = where(small, 1.0, x)
+    # sin(x), not sin(safe): the same value wherever it is used, finite with a
+    # finite derivative where it is not, and the same argument as a cos(x) beside
+    # it, so a loop's sine and cosine share one reduction (quat_power_entries).
     return where(small, series, sin(x) / safe)
 
 
