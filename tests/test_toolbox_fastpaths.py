@@ -214,11 +214,17 @@ def test_slerp_straight_to_its_loop(n, dtype, tol, rng):
     big = np.full(shape, dtype(3e6))
     far = rk.slerp(A, B, big).as_quat()
     ref = _scipy_slerp(q[0], q[1], big)
-    # The angle t theta (up to 3e6 pi ~ 1e7 rad) is rounded in both, each to a few
-    # ulp of itself: the geodesic to that precision.
-    assert np.all(
-        quat_angle(far.reshape(-1, 4), ref) < 3e6 * np.pi * 8 * np.finfo(dtype).eps
+    assert np.all(np.isfinite(far))
+    np.testing.assert_allclose(
+        np.linalg.norm(far, axis=-1), 1.0, rtol=8 * np.finfo(dtype).eps
     )
+    if dtype == np.float64:
+        # The angle t theta (up to 3e6 pi ~ 1e7 rad) is rounded in both, each to a
+        # few ulp of itself: the geodesic to that precision (1.7e-8 rad).
+        assert np.all(quat_angle(far, ref) < 3e6 * np.pi * 8 * np.finfo(dtype).eps)
+    # float32: the relative angle carries ~1e-7 rad, times 3e6, so no geodesic is
+    # left to compare; what must hold is a finite unit quaternion (no NaN of the
+    # fast sine let through), asserted above.
 
 
 def test_slerp_of_other_layouts_and_dtypes_takes_the_general_path(rng):
@@ -228,9 +234,9 @@ def test_slerp_of_other_layouts_and_dtypes_takes_the_general_path(rng):
     q = rng.standard_normal((2, 12, 4))
     A, B = rk.Rotation.from_quat(q[0]), rk.Rotation.from_quat(q[1])
     t = rng.uniform(0.0, 1.0, 24)
-    ref = _scipy_slerp(q[0], q[1], t[::2])
     for tt in (t[::2], t[::2].astype(np.float32), t[::2].tolist()):
-        assert np.all(quat_angle(rk.slerp(A, B, tt).as_quat(), ref) < 1e-6)
+        ref = _scipy_slerp(q[0], q[1], np.asarray(tt, np.float64))
+        assert np.all(quat_angle(rk.slerp(A, B, tt).as_quat(), ref) < 1e-14)
     row = rk.slerp(A[:1], B, t[::2]).as_quat()
     assert np.all(
         quat_angle(row, _scipy_slerp(np.repeat(q[0, :1], 12, 0), q[1], t[::2])) < 1e-14
