@@ -24,6 +24,8 @@ from .errors import (  # noqa: F401  (exported below as listed in errors.__all__
     RigidkitError,
     ShapeError,
     SingularMatrixError,
+    TimestampError,
+    TrajectoryFileError,
     ZeroNormError,
 )
 from .errors import __all__ as _error_names
@@ -59,6 +61,9 @@ _LAZY = {
     "chordal_distance": ("objects.rotation", "chordal_distance"),
     "quat_continuous": ("functional.sequences", "quat_continuous"),
     "unwrap_euler": ("functional.sequences", "unwrap_euler"),
+    "Trajectory": ("applications.trajectory", "Trajectory"),
+    "trajectory": ("applications.trajectory", None),
+    "io": ("applications.io", None),
 }
 
 # The public module paths predate the layered tree (docs/architecture.md):
@@ -144,6 +149,10 @@ __all__ = [
     "chordal_distance",
     "quat_continuous",
     "unwrap_euler",
+    # trajectories and their files
+    "Trajectory",
+    "trajectory",
+    "io",
     # functional layers
     "conversions",
     "euler",

@@ -20,6 +20,8 @@ __all__ = [
     "PointAtInfinityError",
     "DegenerateInputError",
     "OutOfRangeError",
+    "TimestampError",
+    "TrajectoryFileError",
     "GimbalLockError",
     "FrameError",
     "GimbalLockWarning",
@@ -177,3 +179,38 @@ class GimbalLockWarning(UserWarning):
 class ConvergenceWarning(UserWarning):
     """An iteration (the Karcher mean, a spline solve) stopped at its step limit
     before reaching its tolerance; the last iterate is returned."""
+
+
+class TimestampError(RigidkitError):
+    """Time stamps that are not finite or not strictly increasing (``index``: the
+    first offending position), or a trajectory without stamps where they are
+    needed."""
+
+
+class TrajectoryFileError(RigidkitError):
+    """A trajectory file that cannot be read as its format says.
+
+    The message names the file, the 1-based line and what is wrong; ``path`` and
+    ``line`` hold the first two (``line`` is ``None`` for an error about the whole
+    file) and ``index`` is the 0-based data row, as for the other errors.
+
+    >>> err = TrajectoryFileError("gt.txt line 4: 7 fields, expected 8", path="gt.txt",
+    ...                           line=4, index=(2,))
+    >>> err.line, err.index
+    (4, (2,))
+    """
+
+    def __init__(self, message="", *, path=None, line=None, index=None):
+        super().__init__(message, index=index)
+        self.path = path
+        self.line = None if line is None else int(line)
+
+    def __reduce__(self):
+        return (
+            _rebuild_file_error,
+            (type(self), str(self), self.path, self.line, self.index),
+        )
+
+
+def _rebuild_file_error(cls, message, path, line, index):
+    return cls(message, path=path, line=line, index=index)

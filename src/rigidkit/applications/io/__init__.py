@@ -1,0 +1,9 @@
+"""File formats: the one home of rigidkit's readers and writers.
+
+:func:`read_trajectory` and :func:`write_trajectory` handle pose trajectories in
+the TUM RGB-D, KITTI odometry, EuRoC (ASL) and headed-CSV formats.
+"""
+
+from .trajectory_files import FORMATS, read_trajectory, write_trajectory
+
+__all__ = ["FORMATS", "read_trajectory", "write_trajectory"]

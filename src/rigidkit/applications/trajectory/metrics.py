@@ -1,0 +1,371 @@
+"""Absolute and relative pose errors (APE, RPE) with evo's definitions.
+
+The error of a pose is a rigid motion ``E``; a *relation* reduces it to a number
+(Sturm et al. 2012, Sec. VI; evo's ``PoseRelation``):
+
+- ``"translation"``: ``|t_E|``;
+- ``"rotation_angle"``: the angle of ``R_E`` (radians, or degrees);
+- ``"rotation_part"``: ``|R_E - I|_F = 2 sqrt(2) sin(theta / 2)``;
+- ``"full"``: ``|E - I_4|_F = sqrt(8 sin^2(theta / 2) + |t_E|^2)``;
+- ``"point_distance"``: the distance of the two positions (APE) or the
+  difference of the distances that a pose pair spans in each (RPE).
+
+The closed forms use ``|R - I|_F^2 = 2 (3 - tr R) = 8 sin^2(theta / 2)`` and the
+unit quaternion's ``|q_vec| = sin(theta / 2)``: no matrix is formed, and the
+rotation error keeps its relative precision for small angles.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...errors import ShapeError
+from .trajectory import Trajectory
+
+__all__ = ["RELATIONS", "UNITS", "MetricResult", "ape", "pair_indices", "rpe", "statistics"]
+
+RELATIONS = ("translation", "rotation_angle", "rotation_part", "full", "point_distance")
+UNITS = ("frames", "meters", "degrees", "radians")
+_SQRT8 = np.sqrt(8.0)
+
+
+def statistics(errors) -> dict:
+    """``rmse, mean, median, std, min, max, sse`` of ``errors`` (last axis), floats.
+
+    ``std`` is the population standard deviation (``ddof=0``), ``sse`` the sum of
+    squares, as evo reports them.
+
+    >>> bool(statistics(np.array([3.0, 4.0]))["rmse"] == np.sqrt(12.5))
+    True
+    """
+    e = np.asarray(errors, dtype=np.float64)
+    if e.shape[-1] == 0:
+        raise ShapeError("no errors to summarise (no pose or pair was compared)")
+    sse = np.einsum("...i,...i->...", e, e)
+    stats = {
+        "rmse": np.sqrt(sse / e.shape[-1]),
+        "mean": e.mean(axis=-1),
+        "median": np.median(e, axis=-1),
+        "std": e.std(axis=-1),
+        "min": e.min(axis=-1),
+        "max": e.max(axis=-1),
+        "sse": sse,
+    }
+    return {k: float(v) if np.ndim(v) == 0 else v for k, v in stats.items()}
+
+
+@dataclass(frozen=True, eq=False)
+class MetricResult:
+    """The errors of :func:`ape` or :func:`rpe` and their statistics.
+
+    Attributes
+    ----------
+    errors : ndarray, shape (..., M)
+        One error per pose (APE) or pair (RPE).
+    stamps : ndarray, shape (M,), or None
+        The reference stamp of each pose (APE), of each pair's first pose (RPE).
+    pairs : ndarray of int, shape (M, 2), or None
+        RPE: the index pairs ``(i, j)`` compared; ``None`` for APE.
+    stats : dict
+        ``rmse, mean, median, std, min, max, sse`` (see :func:`statistics`).
+    relation, unit : str
+        What the numbers are: the relation, and ``"m"``, ``"rad"``, ``"deg"`` or
+        ``"unit-less"``.
+    """
+
+    errors: np.ndarray
+    stamps: np.ndarray | None
+    pairs: np.ndarray | None
+    stats: dict
+    relation: str
+    unit: str
+
+    def __repr__(self):
+        s = self.stats
+        body = ", ".join(f"{k}={s[k]:.6g}" for k in ("rmse", "mean", "max"))
+        kind = "RPE" if self.pairs is not None else "APE"
+        return f"<{kind} {self.relation} [{self.unit}]: n={self.errors.shape[-1]}, {body}>"
+
+
+def _check(relation, ref, est):
+    if relation not in RELATIONS:
+        raise ValueError(
+            f"relation must be one of {', '.join(RELATIONS)}; got {relation!r}"
+        )
+    for name, traj in (("ref", ref), ("est", est)):
+        if not isinstance(traj, Trajectory):
+            raise TypeError(f"{name} must be a Trajectory, got {type(traj).__name__}")
+    if len(ref) != len(est):
+        raise ShapeError(
+            f"ref has {len(ref)} poses and est {len(est)}: compare corresponding poses "
+            "(rigidkit.trajectory.associate pairs them)"
+        )
+
+
+def _unit(relation, degrees):
+    if relation in ("translation", "point_distance"):
+        return "m"
+    if relation == "rotation_angle":
+        return "deg" if degrees else "rad"
+    return "unit-less"
+
+
+def _reduce(E, relation, degrees):
+    """The number of each error motion ``E`` (a Transform) under ``relation``."""
+    pq = np.asarray(E.as_pq())  # (x, y, z, w, qx, qy, qz)
+    if relation == "translation":
+        return np.linalg.norm(pq[..., :3], axis=-1)
+    sin_half = np.linalg.norm(pq[..., 4:], axis=-1)
+    if relation == "rotation_angle":
+        angle = 2.0 * np.arctan2(sin_half, np.abs(pq[..., 3]))
+        return np.degrees(angle) if degrees else angle
+    if relation == "rotation_part":
+        return _SQRT8 * sin_half
+    # full
+    return np.sqrt(
+        8.0 * sin_half**2 + np.einsum("...i,...i->...", pq[..., :3], pq[..., :3])
+    )
+
+
+def ape(ref, est, relation="translation", degrees=False):
+    """Absolute pose error of each pose: ``E_i = est_i^-1 ref_i`` under ``relation``.
+
+    Parameters
+    ----------
+    ref, est : Trajectory
+        Corresponding poses (associated and, usually, aligned); batches of shape
+        ``(..., N)`` broadcast.
+    relation : str
+        One of :data:`RELATIONS` (see the module); ``"point_distance"`` is
+        ``|p_ref_i - p_est_i|``.
+    degrees : bool
+        ``"rotation_angle"`` in degrees.
+
+    Returns
+    -------
+    MetricResult
+        ``errors`` of shape (..., N), ``stamps`` those of ``ref``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import rigidkit as rk
+    >>> ref = rk.Trajectory([0.0, 1.0], rk.Transform(translation=[[0, 0, 0], [1.0, 0, 0]]))
+    >>> est = rk.Trajectory([0.0, 1.0], rk.Transform(translation=[[0, 0, 0], [1, 0.5, 0]]))
+    >>> r = rk.trajectory.ape(ref, est)
+    >>> r.errors
+    array([0. , 0.5])
+    >>> round(r.stats["rmse"], 12)
+    0.353553390593
+    """
+    _check(relation, ref, est)
+    if relation == "point_distance":
+        d = np.asarray(ref.positions) - np.asarray(est.positions)
+        errors = np.linalg.norm(d, axis=-1)
+    else:
+        errors = _reduce(est.poses.inv() @ ref.poses, relation, degrees)
+    return MetricResult(
+        errors, ref.stamps, None, statistics(errors), relation, _unit(relation, degrees)
+    )
+
+
+def _angles_to_next(poses):
+    """The rotation angle between consecutive poses, shape (N - 1,)."""
+    q = np.asarray(poses.rotation.as_quat())
+    dot = np.abs(np.einsum("...i,...i->...", q[:-1], q[1:]))
+    return _angle_from_dot(dot, q[:-1], q[1:])
+
+
+def _angle_from_dot(dot, a, b):
+    # 2 acos|a.b| loses precision near 0; 2 atan2(|a - b s|, |a + b s|) with
+    # s = sign(a.b) is the same angle, accurate everywhere.
+    s = np.where(dot >= 0, 1.0, -1.0)[..., None] if False else None
+    del s
+    sgn = np.sign(np.einsum("...i,...i->...", a, b))
+    sgn = np.where(sgn == 0, 1.0, sgn)[..., None]
+    return 4.0 * np.arctan2(
+        np.linalg.norm(a - sgn * b, axis=-1), np.linalg.norm(a + sgn * b, axis=-1)
+    )
+
+
+def _walk(cumulative, delta):
+    """Indices chosen by walking: from each chosen index, the first later one whose
+    accumulated amount reaches ``delta``; one searchsorted per chosen index."""
+    chosen = [0]
+    n = len(cumulative)
+    i = 0
+    while True:
+        j = int(np.searchsorted(cumulative, cumulative[i] + delta, side="left"))
+        # cumulative[i] + delta rounds: confirm with the difference itself.
+        while j < n and cumulative[j] - cumulative[i] < delta:
+            j += 1
+        while j - 1 > i and cumulative[j - 1] - cumulative[i] >= delta:
+            j -= 1
+        if j >= n:
+            return np.asarray(chosen, dtype=np.intp)
+        chosen.append(j)
+        i = j
+
+
+def pair_indices(poses, delta, unit="frames", all_pairs=False, tolerance=0.1):
+    """The index pairs ``(i, j)`` that :func:`rpe` compares, shape (M, 2).
+
+    Chosen on ``poses`` (a Transform of shape (N,)) as evo chooses them:
+
+    - ``"frames"``: ``(0, d), (d, 2d), ...`` (``d = delta``, an integer); with
+      ``all_pairs``, every ``(i, i + d)``.
+    - ``"meters"``: walking along the path from the last chosen index, the
+      first index whose travelled distance from it reaches ``delta``, each chosen
+      index paired with the next; with ``all_pairs``, for every ``i`` the later
+      ``j`` whose travelled distance from ``i`` is closest to ``delta`` (the
+      earlier of two), kept if it differs from ``delta`` by at most
+      ``tolerance * delta``.
+    - ``"degrees"``/``"radians"``: as ``"meters"`` with the rotation angles
+      between consecutive poses accumulated; with ``all_pairs``, every pair
+      ``i < j`` whose direct rotation angle differs from ``delta`` by at most
+      ``tolerance * delta`` (an O(N^2) search, in blocks).
+    """
+    n = poses.shape[-1]
+    if unit not in UNITS:
+        raise ValueError(f"unit must be one of {', '.join(UNITS)}; got {unit!r}")
+    if unit == "frames":
+        d = int(delta)
+        if d != delta or d < 1:
+            raise ValueError(f"delta in frames must be a whole number >= 1, got {delta!r}")
+        if all_pairs:
+            i = np.arange(max(n - d, 0))
+            return np.stack([i, i + d], axis=-1)
+        ids = np.arange(0, n, d)
+        return np.stack([ids[:-1], ids[1:]], axis=-1)
+    delta = float(delta)
+    if not delta > 0:
+        raise ValueError(f"delta must be positive, got {delta!r}")
+    if unit == "meters":
+        p = np.asarray(poses.translation)
+        steps = np.linalg.norm(np.diff(p, axis=0), axis=-1)
+    else:
+        if unit == "degrees":
+            delta = np.radians(delta)
+        if all_pairs:
+            return _angle_pairs(poses, delta, tolerance * delta)
+        steps = _angles_to_next(poses)
+    cumulative = np.concatenate([[0.0], np.cumsum(steps)])
+    if not all_pairs:
+        ids = _walk(cumulative, delta) if n else np.zeros(0, dtype=np.intp)
+        return np.stack([ids[:-1], ids[1:]], axis=-1)
+    # For each i, the j > i with cumulative[j] - cumulative[i] closest to delta:
+    # the two neighbours of the target value.
+    i = np.arange(n)
+    hi = np.minimum(np.searchsorted(cumulative, cumulative + delta, side="left"), n - 1)
+    # The candidate below the target: the first index holding its value (a pose
+    # repeated by association adds a step of zero; the earliest index wins ties).
+    lo = np.searchsorted(cumulative, cumulative[np.maximum(hi - 1, 0)], side="left")
+    lo = np.minimum(np.maximum(lo, i + 1), n - 1)
+    hi = np.maximum(hi, lo)
+    gap_lo = np.abs(cumulative[lo] - cumulative - delta)
+    gap_hi = np.abs(cumulative[hi] - cumulative - delta)
+    j = np.where(gap_hi < gap_lo, hi, lo)
+    gap = np.minimum(gap_lo, gap_hi)
+    keep = (i + 1 < n) & (gap <= tolerance * delta)
+    return np.stack([i[keep], j[keep]], axis=-1)
+
+
+def _angle_pairs(poses, delta, tol, block=1024):
+    q = np.asarray(poses.rotation.as_quat())
+    n = len(q)
+    out_i, out_j = [], []
+    for start in range(0, n, block):
+        a = q[start : start + block]
+        dot = np.abs(a @ q.T)
+        angle = 2.0 * np.arccos(np.minimum(dot, 1.0))
+        rows = np.arange(start, start + len(a))[:, None]
+        ok = (np.abs(angle - delta) <= tol) & (np.arange(n)[None, :] > rows)
+        ii, jj = np.nonzero(ok)
+        out_i.append(ii + start)
+        out_j.append(jj)
+    if not out_i:
+        return np.zeros((0, 2), dtype=np.intp)
+    return np.stack([np.concatenate(out_i), np.concatenate(out_j)], axis=-1)
+
+
+def rpe(
+    ref,
+    est,
+    delta=1,
+    unit="frames",
+    relation="translation",
+    all_pairs=False,
+    tolerance=0.1,
+    degrees=False,
+    pairs_from="estimate",
+):
+    """Relative pose error of pose pairs: ``E_ij = (ref_i^-1 ref_j)^-1 (est_i^-1 est_j)``.
+
+    Parameters
+    ----------
+    ref, est : Trajectory
+        Corresponding poses (associated), equal length ``N``.
+    delta : float
+        The spacing of a pair, in ``unit``.
+    unit : {"frames", "meters", "degrees", "radians"}
+        How pairs are chosen: see :func:`pair_indices`.
+    relation : str
+        One of :data:`RELATIONS`; ``"point_distance"`` is ``| |p_j - p_i|_est -
+        |p_j - p_i|_ref |``, the difference of the distances the pair spans.
+    all_pairs : bool
+        Every pair at spacing ``delta`` (overlapping), not consecutive ones.
+    tolerance : float
+        ``all_pairs`` with a metric unit: the largest relative difference of a
+        pair's spacing from ``delta``.
+    degrees : bool
+        ``"rotation_angle"`` in degrees.
+    pairs_from : {"estimate", "reference"}
+        The trajectory whose path chooses the pairs (evo's default: the estimate).
+
+    Returns
+    -------
+    MetricResult
+        ``errors`` of shape (M,), ``pairs`` (M, 2), ``stamps`` the reference
+        stamps of each pair's first pose.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import rigidkit as rk
+    >>> x = np.arange(4.0)
+    >>> ref = rk.Trajectory(x, rk.Transform(translation=np.c_[x, 0 * x, 0 * x]))
+    >>> est = rk.Trajectory(x, rk.Transform(translation=np.c_[1.1 * x, 0 * x, 0 * x]))
+    >>> r = rk.trajectory.rpe(ref, est, delta=1)
+    >>> r.pairs.tolist(), np.round(r.errors, 12).tolist()
+    ([[0, 1], [1, 2], [2, 3]], [0.1, 0.1, 0.1])
+    """
+    _check(relation, ref, est)
+    if pairs_from not in ("estimate", "reference"):
+        raise ValueError(
+            f"pairs_from must be 'estimate' or 'reference', got {pairs_from!r}"
+        )
+    chooser = est if pairs_from == "estimate" else ref
+    if len(chooser.shape) != 1:
+        raise ShapeError("rpe takes one trajectory pair (poses of shape (N,)), not a batch")
+    pairs = pair_indices(chooser.poses, delta, unit, all_pairs, tolerance)
+    if len(pairs) == 0:
+        raise ShapeError(
+            f"no pose pair is {delta!r} {unit} apart in a trajectory of {len(ref)} poses"
+        )
+    i, j = pairs[:, 0], pairs[:, 1]
+    if relation == "point_distance":
+        pr, pe = np.asarray(ref.positions), np.asarray(est.positions)
+        errors = np.abs(
+            np.linalg.norm(pe[j] - pe[i], axis=-1) - np.linalg.norm(pr[j] - pr[i], axis=-1)
+        )
+    else:
+        R, P = ref.poses, est.poses
+        rel_ref = R[i].inv() @ R[j]
+        rel_est = P[i].inv() @ P[j]
+        errors = _reduce(rel_ref.inv() @ rel_est, relation, degrees)
+    stamps = None if ref.stamps is None else ref.stamps[i]
+    return MetricResult(
+        errors, stamps, pairs, statistics(errors), relation, _unit(relation, degrees)
+    )

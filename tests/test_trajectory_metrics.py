@@ -1,0 +1,354 @@
+"""Association, alignment, APE and RPE against evo (the reference), and by hand.
+
+evo (GPLv3) is only called, never copied: the tests write TUM files, read them
+with both libraries and compare every error to 1e-9 relative. Where evo is not
+installed those tests skip; the hand-computed cases always run.
+"""
+
+from __future__ import annotations
+
+import copy
+import warnings
+
+import numpy as np
+import pytest
+
+import rigidkit as rk
+from rigidkit.applications.trajectory import align, ape, associate, rpe
+
+RTOL = 1e-9
+
+
+def _write_tum(path, t, p, q_xyzw):
+    np.savetxt(path, np.column_stack([t, p, q_xyzw]), fmt="%.9f")
+
+
+def _rotvecs_to_xyzw(rv):
+    # Via rigidkit's own conversion; the file is the shared input of both libraries.
+    return rk.Rotation.from_rotvec(rv).as_quat(scalar_first=False)
+
+
+@pytest.fixture(scope="module")
+def tum_pair(tmp_path_factory):
+    """A reference of 1,500 poses at ~100 Hz and a noisy, scaled, moved estimate of
+    400 of them with jittered stamps (some beyond max_diff)."""
+    rng = np.random.default_rng(7)
+    n = 1500
+    t = 100.0 + np.arange(n) * 0.03 + rng.uniform(0, 0.003, n)
+    p = np.cumsum(rng.normal(size=(n, 3)) * 0.05, axis=0)
+    rv = np.cumsum(rng.normal(size=(n, 3)) * 0.03, axis=0)
+    idx = np.sort(rng.choice(n, 400, replace=False))
+    te = np.sort(t[idx] + rng.normal(0, 0.006, len(idx)))
+    S = rk.Rotation.from_rotvec([0.1, -0.2, 0.5])
+    pe = 0.7 * S.apply(p[idx]) + [1.0, 2.0, 3.0] + rng.normal(0, 0.02, (len(idx), 3))
+    Re = (
+        S
+        @ rk.Rotation.from_rotvec(rv[idx])
+        @ rk.Rotation.from_rotvec(rng.normal(0, 0.01, (len(idx), 3)))
+    )
+    d = tmp_path_factory.mktemp("tum")
+    ref_path, est_path = d / "ref.txt", d / "est.txt"
+    _write_tum(ref_path, t, p, _rotvecs_to_xyzw(rv))
+    _write_tum(est_path, te, pe, Re.as_quat(scalar_first=False))
+    return str(ref_path), str(est_path)
+
+
+def _evo():
+    return pytest.importorskip("evo")
+
+
+def _evo_pair(tum_pair):
+    _evo()
+    from evo.core import sync
+    from evo.tools import file_interface
+
+    ref = file_interface.read_tum_trajectory_file(tum_pair[0])
+    est = file_interface.read_tum_trajectory_file(tum_pair[1])
+    return sync.associate_trajectories(ref, est, max_diff=0.01)
+
+
+def _ours(tum_pair):
+    ref = rk.io.read_trajectory(tum_pair[0], "tum")
+    est = rk.io.read_trajectory(tum_pair[1], "tum")
+    return associate(ref, est, max_diff=0.01)
+
+
+def _evo_relation(relation, degrees=False):
+    from evo.core.metrics import PoseRelation
+
+    return {
+        "translation": PoseRelation.translation_part,
+        "rotation_angle": (
+            PoseRelation.rotation_angle_deg if degrees else PoseRelation.rotation_angle_rad
+        ),
+        "rotation_part": PoseRelation.rotation_part,
+        "full": PoseRelation.full_transformation,
+        "point_distance": PoseRelation.point_distance,
+    }[relation]
+
+
+def _assert_close(ours, theirs):
+    theirs = np.asarray(theirs, dtype=np.float64)
+    assert ours.shape == theirs.shape
+    # An error that is zero in exact arithmetic (the first pose after "origin"
+    # alignment) is rounding noise in both (~1e-16), with no relative precision.
+    exact_zero = theirs < 1e-14
+    np.testing.assert_allclose(ours[~exact_zero], theirs[~exact_zero], rtol=RTOL, atol=0.0)
+    assert (ours[exact_zero] < 1e-14).all()
+
+
+def _assert_stats(ours, theirs):
+    for key in ("rmse", "mean", "median", "std", "min", "max", "sse"):
+        if theirs[key] < 1e-14:  # a zero in exact arithmetic (see _assert_close)
+            assert ours[key] < 1e-14
+            continue
+        np.testing.assert_allclose(ours[key], theirs[key], rtol=RTOL, atol=0.0, err_msg=key)
+
+
+def test_association_equals_evo(tum_pair):
+    a, b = _evo_pair(tum_pair)
+    r, e = _ours(tum_pair)
+    assert 300 < len(r) < 400  # some estimate stamps are beyond max_diff
+    np.testing.assert_array_equal(r.stamps, a.timestamps)
+    np.testing.assert_array_equal(e.stamps, b.timestamps)
+    np.testing.assert_array_equal(r.positions, a.positions_xyz)
+
+
+def _evo_aligned(a, b, method):
+    b = copy.deepcopy(b)
+    a = copy.deepcopy(a)
+    if method == "se3":
+        b.align(a)
+    elif method == "sim3":
+        b.align(a, correct_scale=True)
+    elif method == "scale":
+        b.align(a, correct_only_scale=True)
+    elif method == "origin":
+        b.align_origin(a)
+    return a, b
+
+
+@pytest.mark.parametrize("method", ["none", "se3", "sim3", "scale", "origin"])
+@pytest.mark.parametrize(
+    "relation", ["translation", "rotation_angle", "rotation_part", "full", "point_distance"]
+)
+def test_ape_equals_evo(tum_pair, method, relation):
+    from evo.core import metrics
+
+    a, b = _evo_aligned(*_evo_pair(tum_pair), method)
+    r, e = _ours(tum_pair)
+    aligned, _ = align(e, r, method=method)
+    degrees = relation == "rotation_angle" and method == "se3"
+    m = metrics.APE(_evo_relation(relation, degrees))
+    m.process_data((a, b))
+    ours = ape(r, aligned, relation=relation, degrees=degrees)
+    _assert_close(ours.errors, m.error)
+    _assert_stats(ours.stats, m.get_all_statistics())
+    np.testing.assert_array_equal(ours.stamps, a.timestamps)
+
+
+def test_alignment_first_n_equals_evo(tum_pair):
+    a, b = _evo_pair(tum_pair)
+    b = copy.deepcopy(b)
+    b.align(a, correct_scale=True, n=50)
+    r, e = _ours(tum_pair)
+    aligned, S = align(e, r, method="sim3", first=50)
+    np.testing.assert_allclose(aligned.positions, b.positions_xyz, rtol=0, atol=1e-12)
+    assert isinstance(S, rk.Similarity)
+
+
+_RPE_CASES = [
+    (1, "frames", False),
+    (7, "frames", False),
+    (7, "frames", True),
+    (0.5, "meters", False),
+    (0.5, "meters", True),
+    (2.0, "meters", True),
+    (10.0, "degrees", False),
+    (0.2, "radians", False),
+    (10.0, "degrees", True),
+]
+
+
+@pytest.mark.parametrize("delta,unit,all_pairs", _RPE_CASES)
+@pytest.mark.parametrize(
+    "relation", ["translation", "rotation_angle", "rotation_part", "full", "point_distance"]
+)
+def test_rpe_equals_evo(tum_pair, delta, unit, all_pairs, relation):
+    from evo.core import metrics
+    from evo.core.units import Unit
+
+    a, b = _evo_aligned(*_evo_pair(tum_pair), "sim3")
+    r, e = _ours(tum_pair)
+    aligned, _ = align(e, r, method="sim3")
+    evo_unit = {
+        "frames": Unit.frames,
+        "meters": Unit.meters,
+        "degrees": Unit.degrees,
+        "radians": Unit.radians,
+    }[unit]
+    m = metrics.RPE(
+        _evo_relation(relation),
+        delta=delta,
+        delta_unit=evo_unit,
+        all_pairs=all_pairs,
+        rel_delta_tol=0.1,
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m.process_data((a, b))
+    ours = rpe(r, aligned, delta=delta, unit=unit, relation=relation, all_pairs=all_pairs)
+    if relation == "point_distance":
+        # A difference of two lengths |d_est| - |d_ref|: its rounding is relative to
+        # the lengths (the aligned positions of the two libraries differ by ~1e-15),
+        # so it is compared to 1e-9 of them, not of the (possibly tiny) difference.
+        i, j = ours.pairs.T
+        span = np.linalg.norm(r.positions[j] - r.positions[i], axis=-1)
+        assert np.all(np.abs(ours.errors - m.error) <= RTOL * np.maximum(span, m.error))
+    else:
+        _assert_close(ours.errors, m.error)
+        _assert_stats(ours.stats, m.get_all_statistics())
+
+
+@pytest.mark.parametrize("delta,unit,all_pairs", _RPE_CASES[:6])
+def test_rpe_pairs_from_reference_equals_evo(tum_pair, delta, unit, all_pairs):
+    from evo.core import metrics
+    from evo.core.units import Unit
+
+    a, b = _evo_aligned(*_evo_pair(tum_pair), "se3")
+    r, e = _ours(tum_pair)
+    aligned, _ = align(e, r, method="se3")
+    m = metrics.RPE(
+        metrics.PoseRelation.translation_part,
+        delta=delta,
+        delta_unit=Unit.frames if unit == "frames" else Unit.meters,
+        all_pairs=all_pairs,
+        pairs_from_reference=True,
+    )
+    m.process_data((a, b))
+    ours = rpe(
+        r, aligned, delta=delta, unit=unit, all_pairs=all_pairs, pairs_from="reference"
+    )
+    _assert_close(ours.errors, m.error)
+
+
+# -- by hand ---------------------------------------------------------------------------
+
+
+def _line(x, y=None):
+    x = np.asarray(x, dtype=np.float64)
+    y = np.zeros_like(x) if y is None else np.asarray(y, dtype=np.float64)
+    return rk.Trajectory(
+        np.arange(len(x)) * 1.0, rk.Transform(translation=np.c_[x, y, 0 * x])
+    )
+
+
+def test_ape_by_hand():
+    ref = _line([0.0, 1.0, 2.0])
+    est = _line([0.0, 1.0, 2.0], [0.0, 3.0, 4.0])
+    r = ape(ref, est)
+    np.testing.assert_array_equal(r.errors, [0.0, 3.0, 4.0])
+    assert r.stats["sse"] == 25.0
+    assert r.stats["rmse"] == np.sqrt(25.0 / 3)
+    assert r.stats["median"] == 3.0 and r.stats["max"] == 4.0 and r.stats["min"] == 0.0
+    assert r.stats["std"] == pytest.approx(
+        np.sqrt(((0 - 7 / 3) ** 2 + (3 - 7 / 3) ** 2 + (4 - 7 / 3) ** 2) / 3), rel=1e-15
+    )
+
+
+def test_rotation_relations_by_hand():
+    # est = ref rotated by 0.3 rad about z at the same place: E = Rz(-0.3).
+    stamps = [0.0, 1.0]
+    ref = rk.Trajectory(stamps, rk.Transform(translation=[[0.0, 0, 0], [1.0, 0, 0]]))
+    R = rk.Rotation.from_rotvec([0.0, 0.0, 0.3])
+    est = rk.Trajectory(
+        stamps, rk.Transform(rotation=R, translation=[[0.0, 0, 0], [1.0, 0, 0]])
+    )
+    np.testing.assert_allclose(ape(ref, est, "rotation_angle").errors, 0.3, rtol=1e-15)
+    np.testing.assert_allclose(
+        ape(ref, est, "rotation_angle", degrees=True).errors, np.degrees(0.3), rtol=1e-15
+    )
+    # |Rz(a) - I|_F^2 = 4 (1 - cos a) from the matrix entries.
+    np.testing.assert_allclose(
+        ape(ref, est, "rotation_part").errors, np.sqrt(4 * (1 - np.cos(0.3))), rtol=1e-14
+    )
+    # E = est^-1 ref: translation -Rz(-0.3) p? no: R^T p - R^T p = 0 at equal positions.
+    np.testing.assert_allclose(
+        ape(ref, est, "full").errors, np.sqrt(4 * (1 - np.cos(0.3))), rtol=1e-14
+    )
+
+
+def test_rpe_by_hand_frames_and_meters():
+    # Steps of 1, 2, 1, 2 along x; the estimate drifts 10 % in the second half.
+    x = np.array([0.0, 1.0, 3.0, 4.0, 6.0])
+    xe = np.array([0.0, 1.0, 3.0, 4.1, 6.3])
+    ref, est = _line(x), _line(xe)
+    r = rpe(ref, est, delta=2)
+    np.testing.assert_array_equal(r.pairs, [[0, 2], [2, 4]])
+    np.testing.assert_allclose(r.errors, [0.0, 0.3], rtol=1e-14)
+    r = rpe(ref, est, delta=1, all_pairs=True)
+    np.testing.assert_array_equal(r.pairs, [[0, 1], [1, 2], [2, 3], [3, 4]])
+    # Metres on the estimate's path (0, 1, 3, 4.1, 6.3): from 0, the first index at
+    # >= 3 m is 2; from 2 (3 m), 4 is the first at >= 3 m further.
+    r = rpe(ref, est, delta=3.0, unit="meters")
+    np.testing.assert_array_equal(r.pairs, [[0, 2], [2, 4]])
+    # all pairs: for each i the j closest to 3 m: 0->2 (3.0), 1->3 (3.1),
+    # 2->4 (3.3, within 10 %), 3 has only 2.2 m left (27 % off: dropped).
+    r = rpe(ref, est, delta=3.0, unit="meters", all_pairs=True)
+    np.testing.assert_array_equal(r.pairs, [[0, 2], [1, 3], [2, 4]])
+
+
+def test_associate_by_hand():
+    ref = _line(np.arange(5.0))  # stamps 0..4
+    est = rk.Trajectory([0.995, 1.004, 2.5, 3.009], rk.Transform.random(4, rng=0))
+    r, e = associate(ref, est, max_diff=0.01)
+    # est is the shorter: each of its stamps takes the nearest ref stamp; ref's
+    # stamp 1.0 is used twice.
+    np.testing.assert_array_equal(r.stamps, [1.0, 1.0, 3.0])
+    np.testing.assert_array_equal(e.stamps, [0.995, 1.004, 3.009])
+    r, e = associate(ref, est, max_diff=0.01, offset=-0.005)
+    np.testing.assert_array_equal(e.stamps, [1.004, 3.009])
+    with pytest.raises(rk.TimestampError, match=r"ref spans \[0.0, 4.0\]"):
+        associate(ref, est, max_diff=0.01, offset=100.0)
+
+
+def test_associate_interpolate():
+    x = np.arange(5.0)
+    ref = _line(2 * x)
+    est = rk.Trajectory([0.5, 1.25, 3.5, 4.5], rk.Transform.random(4, rng=0))
+    r, e = associate(ref, est, method="interpolate")
+    np.testing.assert_array_equal(e.stamps, [0.5, 1.25, 3.5])
+    np.testing.assert_allclose(r.positions[:, 0], [1.0, 2.5, 7.0], rtol=1e-15)
+    gappy = rk.Trajectory([0.0, 1.0, 3.0], rk.Transform(translation=np.zeros((3, 3))))
+    r, e = associate(gappy, est, method="interpolate", max_gap=1.5)
+    np.testing.assert_array_equal(e.stamps, [0.5])
+
+
+def test_align_methods_recover_a_known_motion():
+    rng = np.random.default_rng(0)
+    ref = rk.Trajectory(None, rk.Transform.random(20, rng=rng))
+    yaw = rk.Transform(rotation=rk.Rotation.from_rotvec([0, 0, 0.7]), translation=[1, 2, 3])
+    est = ref.transform(yaw.inv())
+    aligned, S = align(est, ref, method="yaw")
+    assert bool(S.approx_equal(yaw, atol=1e-12))
+    np.testing.assert_allclose(aligned.positions, ref.positions, atol=1e-12)
+    aligned, S = align(est, ref, method="origin")
+    assert bool((aligned.poses[0]).approx_equal(ref.poses[0], atol=1e-12))
+    aligned, S = align(est, ref, method="none")
+    np.testing.assert_array_equal(aligned.positions, est.positions)
+
+
+def test_align_batched_equals_one_by_one():
+    rng = np.random.default_rng(1)
+    ref = rk.Trajectory(None, rk.Transform.random((3, 30), rng=rng))
+    est = rk.Trajectory(None, rk.Transform.random((3, 30), rng=rng))
+    for method in ("se3", "sim3", "yaw", "origin"):
+        aligned, S = align(est, ref, method=method)
+        assert S.shape == (3,)
+        for k in range(3):
+            one, Sk = align(
+                rk.Trajectory(None, est.poses[k]), rk.Trajectory(None, ref.poses[k]), method
+            )
+            np.testing.assert_allclose(aligned.positions[k], one.positions, atol=1e-12)
+        errors = ape(ref, aligned).errors
+        assert errors.shape == (3, 30)
