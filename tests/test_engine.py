@@ -38,7 +38,6 @@ from __future__ import annotations
 
 import importlib
 import math
-import pkgutil
 import subprocess
 import sys
 import textwrap
@@ -69,11 +68,10 @@ TOL = 2e-15
 def _collect_kernels() -> dict[str, Kernel]:
     """All Kernel objects of rigidkit.kernels.*, keyed by "module.name" of definition."""
     found: dict[str, Kernel] = {}
-    for info in pkgutil.iter_modules(rigidkit.kernels.__path__):
-        mod = importlib.import_module(f"rigidkit.kernels.{info.name}")
+    for mod in rigidkit.kernels.modules():
         for obj in vars(mod).values():
             if isinstance(obj, Kernel):
-                home = obj.fn.__module__.rsplit(".", 1)[-1]
+                home = obj.fn.__module__.removeprefix("rigidkit.kernels.")
                 found[f"{home}.{obj.name}"] = obj
     return dict(sorted(found.items()))
 
@@ -154,9 +152,9 @@ def _vectors(rng, n):
 
 
 SAMPLERS = {
-    "rotvec.quat_from_rotvec": lambda rng, n, span: [_rotvecs(rng, n, span)],
-    "rotvec.rotvec_from_quat": lambda rng, n, span: [_quats(rng, n, span)],
-    "rotvec.matrix_from_rotvec": lambda rng, n, span: [_rotvecs(rng, n, span)],
+    "so3.quat_from_rotvec": lambda rng, n, span: [_rotvecs(rng, n, span)],
+    "so3.rotvec_from_quat": lambda rng, n, span: [_quats(rng, n, span)],
+    "so3.matrix_from_rotvec": lambda rng, n, span: [_rotvecs(rng, n, span)],
     "matrix.matrix_from_quat": lambda rng, n, span: [_quats(rng, n, span)],
     "matrix.quat_from_matrix": lambda rng, n, span: [_matrices(rng, n, span)],
     "mrp.mrp_from_quat": lambda rng, n, span: [_quats(rng, n, span)],
@@ -421,7 +419,7 @@ def _euler_rate_angles(rng, n, params):
 
 
 def _euler_rates(nvec):
-    """Sampler of a kinematics_euler kernel: angles, then ``nvec`` O(1) vectors."""
+    """Sampler of a kinematics.euler_rates kernel: angles, then ``nvec`` O(1) vectors."""
 
     def draw(rng, n, span):
         params = _euler_rate_params(rng)
@@ -484,7 +482,7 @@ PARAM_SAMPLERS = {
         _euler_params(rng, True) + (1e70 if span == 300 else 1e8,),
         [_quats(rng, n, span)],
     ),
-    "pose_formats.pose_distance": lambda rng, n, span: (
+    "se3.pose_distance": lambda rng, n, span: (
         (2.0, 0.5),  # rotation_weight, translation_weight
         [*_pose_pair(rng, n)],
     ),
@@ -493,63 +491,63 @@ PARAM_SAMPLERS = {
     "davenport.davenport_from_quat": _davenport_from_quat,
     "geodesic.quat_from_two_vectors": _two_vectors,
     # Moving frames, world (body=0) or body (1) velocities; O(1) rates.
-    "kinematics.omega_from_matrix_derivative": _kin(_matrix_rate),
-    "kinematics.alpha_from_matrix_second_derivative": _kin(_matrix_accel),
-    "kinematics.matrix_derivative_from_omega": _kin(
+    "kinematics.rotation.omega_from_matrix_derivative": _kin(_matrix_rate),
+    "kinematics.rotation.alpha_from_matrix_second_derivative": _kin(_matrix_accel),
+    "kinematics.rotation.matrix_derivative_from_omega": _kin(
         lambda rng, n: [_rotations(rng, n), *_normal(rng, n, (3,))]
     ),
-    "kinematics.matrix_second_derivative": _kin(
+    "kinematics.rotation.matrix_second_derivative": _kin(
         lambda rng, n: [_rotations(rng, n), *_normal(rng, n, (3,), (3,))]
     ),
-    "kinematics.matrix_derivative_from_twist": _kin(
+    "kinematics.twist.matrix_derivative_from_twist": _kin(
         lambda rng, n: [_homogeneous(rng, n), *_normal(rng, n, (6,))]
     ),
-    "kinematics.matrix_second_derivative_from_twist": _kin(
+    "kinematics.twist.matrix_second_derivative_from_twist": _kin(
         lambda rng, n: [_homogeneous(rng, n), *_normal(rng, n, (6,), (6,))]
     ),
-    "kinematics.twist_from_matrix_derivative": _kin(_homogeneous_rate),
-    "kinematics.twist_change_frame": _kin(  # inverse=0: body to world, 1: back
+    "kinematics.twist.twist_from_matrix_derivative": _kin(_homogeneous_rate),
+    "kinematics.twist.twist_change_frame": _kin(  # inverse=0: body to world, 1: back
         lambda rng, n: [_homogeneous(rng, n), *_normal(rng, n, (6,))]
     ),
-    "kinematics.quat_derivative": _kin(
+    "kinematics.rotation.quat_derivative": _kin(
         lambda rng, n: [_unit(rng, n, 4), *_normal(rng, n, (3,))]
     ),
-    "kinematics.quat_second_derivative": _kin(
+    "kinematics.rotation.quat_second_derivative": _kin(
         lambda rng, n: [_unit(rng, n, 4), *_normal(rng, n, (3,), (3,))]
     ),
-    "kinematics.omega_from_quat_derivative": _kin(_quat_rate),
+    "kinematics.rotation.omega_from_quat_derivative": _kin(_quat_rate),
     # Euler-rate kinematics of ZYX or zxz, the middle angle away from gimbal lock.
-    "kinematics_euler.rate_matrix_from_euler": _euler_rates(0),
-    "kinematics_euler.rate_matrix_inverse_from_euler": _euler_rates(0),
-    "kinematics_euler.rate_matrix_derivative_from_euler": _euler_rates(1),
-    "kinematics_euler.omega_from_euler_rates": _euler_rates(1),
-    "kinematics_euler.euler_rates_from_omega": _euler_rates(1),
-    "kinematics_euler.alpha_from_euler_accelerations": _euler_rates(2),
-    "kinematics_euler.euler_accelerations_from_alpha": _euler_rates(2),
+    "kinematics.euler_rates.rate_matrix_from_euler": _euler_rates(0),
+    "kinematics.euler_rates.rate_matrix_inverse_from_euler": _euler_rates(0),
+    "kinematics.euler_rates.rate_matrix_derivative_from_euler": _euler_rates(1),
+    "kinematics.euler_rates.omega_from_euler_rates": _euler_rates(1),
+    "kinematics.euler_rates.euler_rates_from_omega": _euler_rates(1),
+    "kinematics.euler_rates.alpha_from_euler_accelerations": _euler_rates(2),
+    "kinematics.euler_rates.euler_accelerations_from_alpha": _euler_rates(2),
     # Integration steps: rates at start, middle and end, steps of 1e-4 ... 1.
-    "kinematics_integration.so3_chain": _kin(
+    "kinematics.integration.so3_chain": _kin(
         lambda rng, n: [_unit(rng, n, 4), _unit(rng, n, 4)]
     ),
-    "kinematics_integration.se3_chain": _kin(
+    "kinematics.integration.se3_chain": _kin(
         lambda rng, n: [_poses(rng, n, 0), _poses(rng, n, 0)]
     ),
-    "kinematics_integration.so3_increment_rk4": _kin(
+    "kinematics.integration.so3_increment_rk4": _kin(
         lambda rng, n: [*_normal(rng, n, (3,), (3,), (3,)), _steps(rng, n)]
     ),
-    "kinematics_integration.se3_increment_rk4": _kin(
+    "kinematics.integration.se3_increment_rk4": _kin(
         lambda rng, n: [*_normal(rng, n, (6,), (6,), (6,)), _steps(rng, n)]
     ),
-    "kinematics_planar.twist_from_matrix_derivative_2d": _kin(_homogeneous_rate_2d),
-    "kinematics_planar.matrix_derivative_from_twist_2d": _kin(
+    "kinematics.planar.twist_from_matrix_derivative_2d": _kin(_homogeneous_rate_2d),
+    "kinematics.planar.matrix_derivative_from_twist_2d": _kin(
         lambda rng, n: [_homogeneous_2d(rng, n), *_normal(rng, n, (3,))]
     ),
-    "kinematics_planar.twist_change_frame_2d": _kin(  # to_body=0: to world, 1: to body
+    "kinematics.planar.twist_change_frame_2d": _kin(  # to_body=0: to world, 1: to body
         lambda rng, n: [_homogeneous_2d(rng, n), *_normal(rng, n, (3,))]
     ),
-    "kinematics_planar.se2_chain": _kin(
+    "kinematics.planar.se2_chain": _kin(
         lambda rng, n: [_poses_2d(rng, n), _poses_2d(rng, n)]
     ),
-    "kinematics_planar.se2_increment_rk4": _kin(
+    "kinematics.planar.se2_increment_rk4": _kin(
         lambda rng, n: [*_normal(rng, n, (3,), (3,), (3,)), _steps(rng, n)]
     ),
 }
@@ -791,7 +789,7 @@ SYMPY_SKIP = {
     "euler.euler_from_quat_checked": "euler_from_quat (checked here) with a range test "
     "on |q| in front: over symbols SymPy meets a NaN comparison in the Piecewise; the "
     "kernel exists to validate NumPy input in the loop's own pass",
-    "kinematics_integration.se3_increment_rk4": "three nested se(3) brackets, then exp: "
+    "kinematics.integration.se3_increment_rk4": "three nested se(3) brackets, then exp: "
     "SymPy takes ~3.5 s (so3_increment_rk4 and pose_from_twist are checked)",
 }
 
@@ -988,7 +986,7 @@ def test_no_call_waits_for_a_compile(monkeypatch):
         return real(kernel, *args)
 
     monkeypatch.setattr(numba_backend, "compile_loop", spy)
-    k0 = KERNELS["rotvec.quat_from_rotvec"]
+    k0 = KERNELS["so3.quat_from_rotvec"]
     cold = Kernel(k0.fn, k0.inputs, k0.outputs, k0.params)
     rng = np.random.default_rng(11)
     for shape in [(), (2,), (16,), (17,), (1000,), (10, 100), (1, 1000), (5000,)]:

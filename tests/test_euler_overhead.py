@@ -25,9 +25,10 @@ from scipy.spatial.transform import Rotation as SciRot
 import rigidkit as rk
 from rigidkit import euler
 from rigidkit.errors import GimbalLockWarning, NonFiniteError, ZeroNormError
+from rigidkit.functional._gimbal_lock import LIST_SCAN_MAX
 from rigidkit.kernels import euler as kernels
 
-SIZES = [1, 2, 7, euler.LIST_SCAN_MAX, euler.LIST_SCAN_MAX + 1, 150]
+SIZES = [1, 2, 7, LIST_SCAN_MAX, LIST_SCAN_MAX + 1, 150]
 SEQS = ["ZYX", "xyz", "zxz", "YXY"]  # Tait-Bryan and proper, intrinsic and extrinsic
 
 

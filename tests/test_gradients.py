@@ -664,13 +664,13 @@ def test_cos_of_norm_across_its_threshold():
     ``quat_from_rotvec``, whose ``w`` is ``cos(|r|/2)``)."""
     mp = pytest.importorskip("mpmath")
     from rigidkit._engine.primitives import xp_bindings
-    from rigidkit.kernels import rotvec
+    from rigidkit.kernels import so3
 
     t = 0.03 * (1 + np.array([-1e-3, -1e-8, 0.0, 1e-8, 1e-3]))
     n = np.concatenate([np.logspace(-12, 0.5, 120), t, [np.nextafter(0.03, 0), 0.0]])
     with mp.workdps(40):
         ref = np.array([float(mp.cos(mp.mpf(float(x)))) for x in n])
-    h = rotvec.cos_of_norm
+    h = so3.cos_of_norm
     got = {
         "python": np.array([h(float(x * x), float(x)) for x in n]),
         "numpy-xp": h.bound(xp_bindings(np, np.dtype(np.float64), None))(n * n, n),
@@ -683,7 +683,7 @@ def test_cos_of_norm_across_its_threshold():
             float(mp.cos(mp.sqrt(sum(mp.mpf(float(c)) ** 2 for c in v)) / 2)) for v in r
         ]
     # numba rounds |r| itself (1 ulp), which moves cos(|r|/2) by n tan(n) ulp.
-    got["numba"] = (rotvec.quat_from_rotvec(r, backend="numba")[:, 0], ref_r, 1.0)
+    got["numba"] = (so3.quat_from_rotvec(r, backend="numba")[:, 0], ref_r, 1.0)
     for label, (g, want, rounded_norm) in got.items():
         err = np.abs(g - want) / np.asarray(want)
         bound = 2.3e-16 * (1.0 + rounded_norm * n * np.tan(n))

@@ -443,7 +443,7 @@ def test_versinc2_rate_against_mpmath():
     """The angular-acceleration coefficient (2(1 - cos x) - x sin x)/x^4, to a few ulp."""
     import mpmath
 
-    from rigidkit.kernels.so3_rates import versinc2_rate
+    from rigidkit.kernels.so3 import versinc2_rate
 
     xs = np.concatenate([np.geomspace(1e-9, 1.0, 40), np.linspace(1.0, 6.2, 40)])
     with mpmath.workdps(80):  # the closed form cancels ~x^-2 digits near 0

@@ -368,13 +368,14 @@ def test_planar_twists(rng):
 
 def _param_kernels():
     from rigidkit.functional.euler import parse_sequence
-    from rigidkit.kernels import kinematics as k1
-    from rigidkit.kernels import kinematics_euler as k2
-    from rigidkit.kernels import kinematics_integration as k3
-    from rigidkit.kernels import kinematics_planar as k4
+    from rigidkit.kernels.kinematics import euler_rates as k2
+    from rigidkit.kernels.kinematics import integration as k3
+    from rigidkit.kernels.kinematics import planar as k4
+    from rigidkit.kernels.kinematics import rotation as k1
+    from rigidkit.kernels.kinematics import twist as k5
 
     cases = []
-    for mod in (k1, k3, k4):
+    for mod in (k1, k5, k3, k4):
         for obj in vars(mod).values():
             if getattr(obj, "params", None) in (("body",), ("inverse",)):
                 cases += [(obj, (b,)) for b in (0, 1)]

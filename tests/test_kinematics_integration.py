@@ -118,7 +118,7 @@ def test_exact_method_equals_a_scipy_rotation_loop(rng):
 
 def test_batched_trajectories_and_both_scan_bindings(rng, monkeypatch):
     """Many trajectories at once; the compiled scan and the prefix product agree."""
-    from rigidkit.kernels import kinematics_integration as kint
+    from rigidkit.kernels.kinematics import integration as kint
 
     w = rng.standard_normal((3, 4, 500, 3))
     R0 = rk.Rotation.random((4,), rng=2)  # broadcasts against (3, 4)
@@ -144,7 +144,7 @@ def test_batched_trajectories_and_both_scan_bindings(rng, monkeypatch):
 def test_prefix_product_of_every_length(n, rng):
     """The pairwise prefix scheme equals the step-by-step product at odd and even
     lengths (the recursion's ends), both frames."""
-    from rigidkit.kernels import kinematics_integration as kint
+    from rigidkit.kernels.kinematics import integration as kint
 
     q0 = rk.Rotation.random((2,), rng=n).as_quat()
     inc = rk.Rotation.random((2, n), rng=n + 1).as_quat()
@@ -198,7 +198,7 @@ def test_no_call_compiles_the_scan(rng, monkeypatch):
 def test_a_scan_ready_mid_call_takes_over(rng, monkeypatch):
     """Waiting for the scan, a long call runs the prefix product chunk by chunk
     (each from the last state) and hands the rest to the scan once it is ready."""
-    from rigidkit.kernels import kinematics_integration as kint
+    from rigidkit.kernels.kinematics import integration as kint
 
     _scan.wait(kint.so3_chain, np.float64)
     key = ("so3_chain", 4, "d")

@@ -14,8 +14,6 @@ The cache folder is ``$RIGIDKIT_CACHE_DIR`` or ``~/.cache/rigidkit``.
 
 from __future__ import annotations
 
-import importlib
-import pkgutil
 import sys
 import time
 
@@ -26,8 +24,7 @@ def shipped_kernels() -> list:
     from rigidkit._engine import Kernel
 
     found = {}
-    for info in pkgutil.iter_modules(pkg.__path__):
-        module = importlib.import_module(f"{pkg.__name__}.{info.name}")
+    for module in pkg.modules():
         for obj in vars(module).values():
             if isinstance(obj, Kernel):
                 found[(obj.fn.__module__, obj.name)] = obj

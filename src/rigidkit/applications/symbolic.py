@@ -45,11 +45,13 @@ gives exactly what the kernels evaluate, series and thresholds included, as
 ``w >= 0``, a zero norm, Shepperd's four cases) stay ``Piecewise`` in both forms;
 SymPy decides them where the symbols' assumptions allow (``positive=True``, say).
 
-Names: the kernels of SO(3) and quaternions (modules ``so3``, ``so3_jacobians``,
-``quaternion``, ``matrix``, ``rotvec``, ``mrp``, ``axis_angle``, ``euler``,
-``quaternion_algebra``) are top-level, and so is any name defined by a single
-kernel module; every kernel module is also a namespace (``symbolic.se3.hat``),
-and ``symbolic.so3`` holds the SO(3) calculus of ``so3_jacobians`` too. Next to
+Names: the kernels of SO(3) and quaternions (modules ``so3``, ``quaternion``,
+``matrix``, ``mrp``, ``axis_angle``, ``euler``, ``quaternion_algebra``) are
+top-level, and so is any name defined by a single kernel module; every kernel
+module is also a namespace (``symbolic.se3.hat``, ``symbolic.so3.left_jacobian``),
+and ``symbolic.kinematics`` holds the kernels of every module of
+:mod:`rigidkit.kernels.kinematics`, also by module
+(``symbolic.kinematics.rotation``). Next to
 each ``left_jacobian`` and ``left_jacobian_inverse`` (SO(3), SE(2), SE(3)) stand
 ``right_jacobian`` and ``right_jacobian_inverse``, the left ones at ``-x``
 (``J_r(x) = J_l(-x)``):
@@ -64,10 +66,8 @@ Matrix([
 
 from __future__ import annotations
 
-import importlib
 import inspect
 import math
-import pkgutil
 import types
 from fractions import Fraction
 
@@ -80,10 +80,8 @@ from .._engine.primitives import sympy_bindings
 #: Kernel modules whose names are top-level, first one first for shared names.
 _PREFERRED = (
     "so3",
-    "so3_jacobians",
     "quaternion",
     "matrix",
-    "rotvec",
     "mrp",
     "axis_angle",
     "euler",
@@ -265,22 +263,20 @@ def _right(left, name: str):
 
 def _collect():
     by_module: dict[str, dict] = {}
-    for info in pkgutil.iter_modules(_kernels_pkg.__path__):
-        mod = importlib.import_module(f"{_kernels_pkg.__name__}.{info.name}")
+    for mod in _kernels_pkg.modules():
+        module = mod.__name__.removeprefix(f"{_kernels_pkg.__name__}.")
         found = {
-            obj.name: _make(obj, info.name)
+            obj.name: _make(obj, module)
             for obj in vars(mod).values()
             if isinstance(obj, Kernel) and obj.fn.__module__ == mod.__name__
         }
         if found:
-            by_module[info.name] = found
+            by_module[module] = found
     for fns in by_module.values():
         for left in ("left_jacobian", "left_jacobian_inverse"):
             if left in fns:
                 right = left.replace("left", "right", 1)
                 fns.setdefault(right, _right(fns[left], right))
-    # SO(3) calculus under so3 too, as in rk.so3.
-    by_module["so3"] = {**by_module["so3_jacobians"], **by_module["so3"]}
     top: dict[str, object] = {}
     for module in _PREFERRED:
         for name, fn in by_module.get(module, {}).items():
@@ -295,13 +291,42 @@ def _collect():
     return by_module, top
 
 
-_BY_MODULE, _TOP = _collect()
-globals().update(_TOP)
-for _module, _fns in _BY_MODULE.items():
-    if _module not in globals():
-        globals()[_module] = types.SimpleNamespace(**_fns)
+def _namespaces(by_module: dict) -> dict:
+    """A namespace per kernel module; a subpackage's (``kinematics``) holds its
+    modules' namespaces and, flat, all their kernels."""
+    spaces = {module: types.SimpleNamespace(**fns) for module, fns in by_module.items()}
+    for module, fns in by_module.items():
+        parent, _, leaf = module.rpartition(".")
+        if parent:
+            space = spaces.setdefault(parent, types.SimpleNamespace())
+            setattr(space, leaf, spaces[module])
+            for name, fn in fns.items():
+                vars(space).setdefault(name, fn)
+    return {module: space for module, space in spaces.items() if "." not in module}
 
-__all__ = sorted(_TOP) + sorted(m for m in _BY_MODULE if m not in _TOP)
+
+#: Namespaces of kernel modules since merged or moved (issue 16), kept by name.
+_FORMER = {
+    "rotvec": "so3",
+    "so3_jacobians": "so3",
+    "so3_rates": "so3",
+    "dual_quaternion": "pose_formats",
+    "kinematics_euler": "kinematics",
+    "kinematics_integration": "kinematics",
+    "kinematics_planar": "kinematics",
+    "kinematics_screw": "screw",
+}
+
+_BY_MODULE, _TOP = _collect()
+_SPACES = _namespaces(_BY_MODULE)
+globals().update(_TOP)
+for _module, _space in _SPACES.items():
+    if _module not in globals():
+        globals()[_module] = _space
+for _former, _module in _FORMER.items():
+    globals().setdefault(_former, _SPACES[_module])
+
+__all__ = sorted(_TOP) + sorted(m for m in _SPACES if m not in _TOP)
 
 # The kinematics derivations (issue 8) live in their own module.
 from .symbolic_kinematics import (  # noqa: E402

@@ -36,10 +36,10 @@ import sympy as sp
 from .._engine.primitives import sympy_bindings
 from ..functional.euler import parse_sequence
 from ..kernels import euler as _euler
-from ..kernels import kinematics_euler as _ke
 from ..kernels import matrix as _matrix
 from ..kernels import quaternion as _quat
 from ..kernels import se3 as _se3
+from ..kernels.kinematics import euler_rates as _ke
 from .kinematics._common import body_flag
 
 __all__ = ["euler_matrix", "euler_rate_matrix", "quaternion_matrix", "twist_exp"]

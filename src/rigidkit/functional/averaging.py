@@ -49,8 +49,8 @@ from .._engine.namespace import device_of, is_float32, namespace_of
 from .._validate import _relabel, any_true, batch_index, finite_array, where_text
 from ..errors import ConvergenceWarning, DegenerateInputError
 from ..kernels import quaternion as _kq
-from ..kernels import rotvec as _krv
 from ..kernels import se3 as _kse3
+from ..kernels import so3 as _krv
 from . import conversions as _conv
 
 __all__ = [

@@ -56,7 +56,7 @@ from ..kernels import axis_angle as _aa
 from ..kernels import matrix as _mat
 from ..kernels import mrp as _mrp
 from ..kernels import quaternion as _q
-from ..kernels import rotvec as _rv
+from ..kernels import so3 as _rv
 
 __all__ = [
     "quat_normalize",

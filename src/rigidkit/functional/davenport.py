@@ -46,6 +46,7 @@ from .._validate import (
 from ..errors import EulerSequenceError, ShapeError, ZeroNormError
 from ..kernels import davenport as _k
 from . import euler as _euler
+from ._gimbal_lock import warn_if_locked
 
 __all__ = [
     "ORTHOGONALITY_TOL",
@@ -268,7 +269,7 @@ def davenport_from_quat_unchecked(axes, order, quat, *, degrees=False):
     angles, aux = _k.davenport_from_quat(
         rev, scale, tol, q, unit[..., 0, :], unit[..., 1, :], unit[..., 2, :]
     )
-    _euler._warn_if_locked(_LOCK_SEQ[rev], aux, scale)
+    warn_if_locked(_LOCK_SEQ[rev], aux, scale)
     return _nan_where_bad(angles, bad)
 
 

@@ -42,25 +42,23 @@ array([20., 90.,  0.])
 from __future__ import annotations
 
 import math
-import os
-import sys
-import warnings
 from typing import NamedTuple
 
 import numpy as np
 
 from .._engine.namespace import is_float32, is_numpy, namespace_of
-from .._validate import (
-    as_array,
-    batch_index,
-    checks_now,
-    finite_array,
-    to_numpy,
-    where_text,
-)
-from ..errors import EulerSequenceError, GimbalLockWarning
+from .._validate import as_array, finite_array
+from ..errors import EulerSequenceError
 from ..kernels import euler as _k
 from . import conversions as _conv
+from ._gimbal_lock import (
+    LockBand,
+    gimbal_lock_threshold,
+    lock_band,
+    lock_free,
+    lock_tolerance,
+    warn_if_locked,
+)
 
 __all__ = [
     "EulerSequence",
@@ -195,61 +193,8 @@ def _parse(seq, *, short=False) -> EulerSequence:
     return EulerSequence(seq, axes, intrinsic, proper, params)
 
 
-def gimbal_lock_threshold(dtype) -> float:
-    """Distance (radians) of the middle angle from the lock below which we warn.
-
-    ``sqrt(eps)`` of the dtype: 1.5e-8 for float64, 3.5e-4 for float32. The first
-    and third angles have condition number about ``1 / distance`` with respect to
-    the rotation (only their sum or difference is well determined there), so a
-    rotation known to ``eps`` fixes them only to ``eps / distance``: below
-    ``sqrt(eps)`` at least half of their significant digits are noise. The
-    rebuilt rotation stays exact at any distance.
-
-    >>> gimbal_lock_threshold(np.float64), gimbal_lock_threshold(np.float32)
-    (1.4901161193847656e-08, 0.00034526698300124393)
-    """
-    try:
-        return _THRESHOLDS[dtype]
-    except (KeyError, TypeError):
-        pass
-    tol = math.sqrt(_eps(dtype))
-    try:
-        _THRESHOLDS[dtype] = tol
-    except TypeError:  # unhashable dtype object
-        pass
-    return tol
-
-
-_THRESHOLDS: dict = {}
-
-
-def _eps(dtype) -> float:
-    """Machine epsilon of a float dtype of any namespace (float32, else float64)."""
-    return 1.1920928955078125e-07 if is_float32(dtype) else 2.220446049250313e-16
-
-
 def _dtype(a):
     return getattr(a, "dtype", None)  # None (lists, floats): computed in float64
-
-
-def lock_tolerance(dtype) -> float:
-    """Radians the rotation may move to return the lock convention: ``2 eps``.
-
-    4.4e-16 for float64, 2.4e-7 for float32 (the input quaternion's dtype: a
-    float32 quaternion carries float32 rounding, whatever precision the kernel
-    computes in). Changing every component of a quaternion by one ulp (at most
-    ``eps |q_i|``) moves it by at most ``eps |q|``, i.e. the rotation by at most
-    ``2 eps`` rad. So the angles returned at a numerical lock are the exact
-    angles of a rotation no farther from the given one than one-ulp changes of
-    its quaternion reach, and a quaternion computed from lock angles (a rounding
-    residue of a few ulp) is cleaned: for ``from_euler`` at lock we measured a
-    cost of at most 4.2e-16 over a million random float64 cases, all 24
-    sequences, radians and degrees.
-
-    >>> lock_tolerance(np.float64), lock_tolerance(np.float32)
-    (4.440892098500626e-16, 2.384185791015625e-07)
-    """
-    return 2.0 * _eps(dtype)
 
 
 def quat_from_euler(seq, angles, *, degrees=False):
@@ -412,8 +357,8 @@ def euler_from_quat(seq, quat, *, degrees=False):
         s = parse_sequence(seq)  # the sequence first: its error is the likelier one
         if type(quat) is not np.ndarray:
             return _euler_from_quat_validated(s, quat, degrees)
-        e = _call_args(seq, degrees, quat.dtype)
-    s, args = e[0], e[1]
+        e = _call_record(seq, degrees, quat.dtype)
+    s = e.sequence
     dt = quat.dtype
     if type(quat) is not np.ndarray or not (dt is _F64 or dt is _F32):
         return _euler_from_quat_validated(s, quat, degrees)
@@ -422,12 +367,12 @@ def euler_from_quat(seq, quat, *, degrees=False):
     # Validated in the kernel's own pass (see kernels.euler.euler_from_quat_checked):
     # a row that is not finite, zero or of extreme scale has a middle angle of
     # 8 rad, which the lock scan below sends on to the full check.
-    angles = _k.euler_from_quat_checked(*e[4], quat)
-    if _lock_free(angles, e):
+    angles = _k.euler_from_quat_checked(*e.checked_params, quat)
+    if lock_free(angles, e.band):
         return angles
-    if bool((angles[..., 1] > 4.0 * args[5]).any()):
+    if bool((angles[..., 1] > 4.0 * e.scale).any()):
         return _euler_from_quat_validated(s, quat, degrees)
-    _warn_if_locked(s, angles, args[5])
+    warn_if_locked(s, angles, e.scale)
     return angles
 
 
@@ -486,72 +431,47 @@ def euler_from_quat_unchecked(seq, quat, *, degrees=False):
     try:  # the common case in one lookup: ~0.3 us less on a small batch
         e = _CALLS[seq, degrees, quat.dtype]
     except (KeyError, TypeError, AttributeError):
-        e = _call_args(seq, degrees, _dtype(quat))
-    s, args = e[0], e[1]
-    angles = _k.euler_from_quat(*args, quat)
-    if type(angles) is np.ndarray and _lock_free(angles, e):
+        e = _call_record(seq, degrees, _dtype(quat))
+    angles = _k.euler_from_quat(*e.params, quat)
+    if type(angles) is np.ndarray and lock_free(angles, e.band):
         return angles
-    _warn_if_locked(s, angles, args[5])
+    warn_if_locked(e.sequence, angles, e.scale)
     return angles
 
 
-#: NumPy batches up to this long have their middle angles scanned as a sorted Python
-#: list (one C call, ~0.6 us at 10 elements, 1.1 us at 32), longer ones with NumPy
-#: (~1.5 us: two ufunc calls, or three for proper sequences).
-LIST_SCAN_MAX = 40
+class EulerCall(NamedTuple):
+    """The constants of one call, memoised per ``(seq, degrees, dtype)``."""
+
+    #: The parsed sequence.
+    sequence: EulerSequence
+    #: Parameters of the kernel ``euler_from_quat``: the sequence's, ``scale``
+    #: (output units per radian) and the :func:`lock_tolerance` of the dtype.
+    params: tuple
+    #: Parameters of ``euler_from_quat_checked``: ``params`` and the largest
+    #: accepted ``|q|`` (see :func:`_moderate_limit`).
+    checked_params: tuple
+    #: Output units per radian (1, or 180 / pi for degrees).
+    scale: float
+    #: Where the middle angles are not near the lock (see :func:`lock_free`).
+    band: LockBand
 
 
-def _lock_free(angles, e) -> bool:
-    """True when the middle angles of NumPy ``angles`` are all at least
-    :func:`gimbal_lock_threshold` from the lock (``e``: the entry of
-    :func:`_call_args`), with the arithmetic of :func:`_warn_if_locked`.
-
-    False sends the call on to :func:`_warn_if_locked` (which finds out whether
-    any is near the lock) or, in :func:`euler_from_quat`, to the full check. A
-    NaN may give either answer here (a sorted list with NaN is not ordered, where
-    NumPy's max propagates it): it is never a lock, so both are right.
-    """
-    if angles.ndim == 1:
-        return e[2] <= angles.item(1) <= e[3]
-    if angles.ndim != 2:
-        return False
-    n = len(angles)
-    if n <= LIST_SCAN_MAX:
-        if n == 0:
-            return True
-        vals = sorted(angles[:, 1].tolist())
-        return e[2] <= vals[0] and vals[-1] <= e[3]
-    center = e[5]
-    if center == 0.0:  # Tait-Bryan: the lock at +-pi/2
-        dist = np.abs(angles[:, 1])
-    else:
-        dist = angles[:, 1] - center
-        np.abs(dist, out=dist)
-    return bool(_MAX(dist) <= e[6])
-
-
-_MAX = np.maximum.reduce
 _CALLS: dict = {}
 
 
-def _call_args(seq, degrees, dtype) -> tuple:
-    """``(sequence, kernel parameters, lo, hi, checked kernel parameters, center,
-    width)`` of a call: middle angles in ``[lo, hi]``, i.e. with ``|mid - center| <=
-    width``, are not near the lock (see :func:`_warn_if_locked`). Memoised per
-    hashable dtype."""
+def _call_record(seq, degrees, dtype) -> EulerCall:
+    """The :class:`EulerCall` of ``(seq, degrees, dtype)``, memoised per hashable
+    dtype."""
     s = parse_sequence(seq)
     scale = 180.0 / math.pi if degrees else 1.0
-    args = (*s.params, scale, lock_tolerance(dtype))
-    tol = gimbal_lock_threshold(dtype) * scale
-    half = 0.5 * math.pi * scale
-    center = half if s.proper else 0.0
-    cargs = (*args, math.sqrt(_moderate_limit(dtype)))
-    entry = (s, args, center - half + tol, center + half - tol, cargs, center, half - tol)
+    params = (*s.params, scale, lock_tolerance(dtype))
+    checked = (*params, math.sqrt(_moderate_limit(dtype)))
+    record = EulerCall(s, params, checked, scale, lock_band(s.proper, scale, dtype))
     try:
-        _CALLS[seq, bool(degrees), dtype] = entry
+        _CALLS[seq, bool(degrees), dtype] = record
     except TypeError:  # an unhashable dtype object
         pass
-    return entry
+    return record
 
 
 def matrix_from_euler(seq, angles, *, degrees=False):
@@ -594,67 +514,3 @@ def euler_from_matrix(seq, matrix, *, degrees=False, atol=None):
     """
     q = _conv.quat_from_matrix(matrix, atol=atol)  # validated, unit
     return euler_from_quat_unchecked(seq, q, degrees=degrees)
-
-
-def _warn_if_locked(s: EulerSequence, angles, scale: float) -> None:
-    """Emit one :class:`GimbalLockWarning` if any middle angle is near the lock."""
-    dtype = getattr(angles, "dtype", np.float64)
-    tol = gimbal_lock_threshold(dtype) * scale
-    half = 0.5 * math.pi * scale
-    # Lock at 0 and pi (proper) or -pi/2 and pi/2 (Tait-Bryan): |mid - center| = half.
-    center = half if s.proper else 0.0
-    if isinstance(angles, np.ndarray) and angles.ndim == 1:  # one element: no reductions
-        if abs(float(angles[1]) - center) <= half - tol:
-            return
-    mid = angles[..., 1]
-    if isinstance(mid, np.ndarray) and mid.size <= 64:
-        # Small batches: Python's min/max over a list beat two NumPy reductions
-        # (~1 us each). A NaN is never a lock: skipped or not, the outcome is right.
-        vals = mid.ravel().tolist()
-        if not vals or (
-            min(vals) >= center - half + tol and max(vals) <= center + half - tol
-        ):
-            return
-    if isinstance(mid, np.ndarray):
-        if mid.size == 0 or (
-            # Two reductions without temporaries: the common, lock-free case.
-            mid.min() >= center - half + tol and mid.max() <= center + half - tol
-        ):
-            return
-        near = np.abs(mid - center) > half - tol  # False for NaN (never a lock)
-        if not near.any():
-            return
-    else:
-        if not checks_now(mid):  # traced (or Dask) values: no warning; the angles hold
-            return
-        xp = namespace_of(mid)
-        near = xp.abs(mid - center) > half - tol
-        if not bool(xp.any(near)):
-            return
-    near = to_numpy(near)
-    lock = "0 or pi" if s.proper else "+-pi/2"
-    first = batch_index(near)
-    message = (
-        f"gimbal lock in {s.text!r}: {int(near.sum())} of {max(near.size, 1)} middle "
-        f"angles are within {tol / scale:.2g} rad of {lock} (first "
-        f"{where_text(first)}); there only the sum or difference of the "
-        f"first and third angle is well determined. The angles returned rebuild the "
-        f"rotation; at lock (within {lock_tolerance(dtype):.2g} rad) the third angle is 0."
-    )
-    warnings.warn(GimbalLockWarning(message, index=first), stacklevel=_user_stacklevel())
-
-
-_PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-
-
-def _user_stacklevel() -> int:
-    """``stacklevel`` for ``warnings.warn`` that points at the first caller outside
-    rigidkit (so the warning names the user's line, whichever API they called)."""
-    frame = sys._getframe(1)
-    level = 1
-    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(
-        _PACKAGE_DIR + os.sep
-    ):
-        frame = frame.f_back
-        level += 1
-    return level

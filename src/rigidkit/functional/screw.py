@@ -27,7 +27,7 @@ import numpy as np
 from .._engine.namespace import namespace_of
 from .._validate import as_array, batch_index, check_finite, finite_array, where_text
 from ..errors import ZeroNormError
-from ..kernels import kinematics_screw as _k
+from ..kernels import screw as _k
 
 __all__ = ["screw_from_twist", "twist_from_screw"]
 

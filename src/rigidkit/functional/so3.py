@@ -13,9 +13,7 @@ True
 from __future__ import annotations
 
 from .._validate import as_array, finite_array
-from ..kernels import rotvec as _rv
 from ..kernels import so3 as _k
-from ..kernels import so3_jacobians as _jac
 from . import _lie
 from . import conversions as _conv
 
@@ -53,7 +51,7 @@ def exp(w):
     ndarray, shape (..., 3, 3)
         Rotation matrices acting on column vectors.
     """
-    return _rv.matrix_from_rotvec(_rotvec(w))
+    return _k.matrix_from_rotvec(_rotvec(w))
 
 
 def log(R, *, atol=None):
@@ -65,7 +63,7 @@ def log(R, *, atol=None):
     atol : float, optional
         Tolerance of the SO(3) check, see :func:`rigidkit.conversions.quat_from_matrix`.
     """
-    return _rv.rotvec_from_quat(_conv.quat_from_matrix(R, atol=atol))
+    return _k.rotvec_from_quat(_conv.quat_from_matrix(R, atol=atol))
 
 
 def adjoint(R, *, atol=None):
@@ -111,7 +109,7 @@ def bracket(u, v):
     array([0., 0., 1.])
     """
     u = as_array(u, (3,), "so(3) vector")
-    return _jac.bracket(u, as_array(v, (3,), "so(3) vector"))
+    return _k.bracket(u, as_array(v, (3,), "so(3) vector"))
 
 
 def left_jacobian(w):
@@ -139,7 +137,7 @@ def left_jacobian(w):
            [ 0.63662,  0.63662,  0.     ],
            [ 0.     ,  0.     ,  1.     ]])
     """
-    return _jac.left_jacobian(_rotvec(w))
+    return _k.left_jacobian(_rotvec(w))
 
 
 def left_jacobian_inverse(w):
@@ -148,9 +146,9 @@ def left_jacobian_inverse(w):
     ``J_l^-1 = I - hat(w)/2 + (1 - (t/2) cot(t/2))/t^2 hat(w)^2`` for rotation
     vectors ``w`` (..., 3), finite for ``t = |w| < 2 pi``; shape (..., 3, 3).
     """
-    return _jac.left_jacobian_inverse(_rotvec(w))
+    return _k.left_jacobian_inverse(_rotvec(w))
 
 
 right_jacobian, right_jacobian_inverse = _lie.right_jacobians(
-    __name__, "SO(3)", 3, "rotation vector", _jac.left_jacobian, _jac.left_jacobian_inverse
+    __name__, "SO(3)", 3, "rotation vector", _k.left_jacobian, _k.left_jacobian_inverse
 )

@@ -42,10 +42,8 @@ from .._engine import dask_backend
 from .._engine.namespace import device_of, is_float32, namespace_of
 from ..errors import ConvergenceWarning
 from ..kernels import quaternion as _kq
-from ..kernels import rotvec as _krv
 from ..kernels import se3 as _kse3
-from ..kernels import so3_jacobians as _jac
-from ..kernels import so3_rates as _rates
+from ..kernels import so3 as _kso3
 
 __all__ = [
     "rotation_spline_coefficients",
@@ -105,14 +103,14 @@ def _solve_block_tridiagonal(xp, lower, diag, upper, rhs):
 
 def _relative_rotvecs(quats):
     """``log(R_k^-1 R_{k+1})`` of consecutive keyframes (n, ..., 4) -> (n - 1, ..., 3)."""
-    return _krv.rotvec_from_quat(
+    return _kso3.rotvec_from_quat(
         _kq.quat_multiply(_kq.quat_conjugate(quats[:-1]), quats[1:])
     )
 
 
 def _nonlinear(theta, rdot):
     """The ``(dJ_r/dt) r'`` term of the angular acceleration (``r'' = 0``)."""
-    return _rates.body_acceleration_from_rotvec_rates(theta, rdot, rdot * 0.0)
+    return _kso3.body_acceleration_from_rotvec_rates(theta, rdot, rdot * 0.0)
 
 
 def rotation_spline_coefficients(times, quats, *, max_iter=50):
@@ -153,8 +151,8 @@ def rotation_spline_coefficients(times, quats, *, max_iter=50):
     omega = [rates[0]] + [rates[k] for k in range(1, n - 1)] + [rates[n - 2]]
     iterations = 0
     if n > 2:
-        jr = _jac.left_jacobian(-theta)  # J_r(theta) = J_l(-theta)
-        jr_inv = _jac.left_jacobian_inverse(-theta)
+        jr = _kso3.left_jacobian(-theta)  # J_r(theta) = J_l(-theta)
+        jr_inv = _kso3.left_jacobian_inverse(-theta)
         eye = _const(xp, np.eye(3), theta)
         m = n - 2
         # Equation e (interior knot k = e + 1), linear part:
@@ -208,7 +206,7 @@ def rotation_spline_coefficients(times, quats, *, max_iter=50):
     full = xp.stack(omega, axis=0)
     c = full[:-1]
     d = _matvec(
-        _jac.left_jacobian_inverse(-theta), full[1:]
+        _kso3.left_jacobian_inverse(-theta), full[1:]
     )  # r'(h) = J_r^-1(theta) w_{i+1}
     a = (-2.0 * theta + h * c + h * d) / (h * h * h)
     b = (3.0 * theta - 2.0 * h * c - h * d) / (h * h)
@@ -264,11 +262,11 @@ def rotation_spline_eval(times, quats, coeffs, query, order):
     r = ((a * s + b) * s + c) * s
     if order == 0:
         q = _take(xp, quats, idx, dev)
-        return _kq.quat_multiply(q, _krv.quat_from_rotvec(r))
+        return _kq.quat_multiply(q, _kso3.quat_from_rotvec(r))
     rdot = (3.0 * a * s + 2.0 * b) * s + c
     if order == 1:
-        return _rates.body_rate_from_rotvec_rate(r, rdot)
-    return _rates.body_acceleration_from_rotvec_rates(r, rdot, 6.0 * a * s + 2.0 * b)
+        return _kso3.body_rate_from_rotvec_rate(r, rdot)
+    return _kso3.body_acceleration_from_rotvec_rates(r, rdot, 6.0 * a * s + 2.0 * b)
 
 
 def bspline_basis(u):
@@ -387,11 +385,11 @@ def _pose_inverse_adjoint(pose):
 # (exp, compose, inverse_adjoint, apply_adjoint, bracket) of :func:`_cumulative_eval`;
 # on SO(3) ``Ad(A^-1)`` is the rotation ``A^-1``, kept as the conjugate quaternion.
 _SO3_OPS = (
-    _krv.quat_from_rotvec,
+    _kso3.quat_from_rotvec,
     _kq.quat_multiply,
     _kq.quat_conjugate,
     _kq.quat_apply,
-    _jac.bracket,
+    _kso3.bracket,
 )
 _SE3_OPS = (
     _kse3.pose_from_twist,

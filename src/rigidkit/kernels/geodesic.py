@@ -14,9 +14,9 @@ twists ``(v, w)``.
 from .._engine import helper, kernel
 from .coefficients import atan_ratio, norm3, sinc
 from .quaternion import quat_hemisphere, quat_multiply
-from .rotvec import cos_of_norm
 from .se3 import pose_compose, pose_from_twist, pose_inv, twist_from_pose
-from .so3_jacobians import cross3
+from .so3 import cos_of_norm
+from .vector import cross3
 
 
 @helper

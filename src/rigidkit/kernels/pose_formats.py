@@ -1,20 +1,76 @@
-"""Kernels of poses in other software's layouts, the inverse action and a distance.
+"""Kernels of poses in other software's layouts: dual quaternions, pq, exp coords.
 
 Poses are ``(w, x, y, z, tx, ty, tz)``: a unit quaternion (Hamilton, scalar first)
-and a translation, the motion ``p -> R p + t``; our twists are ``(v, w)``.
+and a translation, the motion ``p -> R p + t``; our twists are ``(v, w)``. The
+group operations on poses (compose, inverse, act, exp, log, distance) are SE(3)'s,
+in :mod:`.se3`; this module holds only the conversions to other layouts.
 
 ====================  ==================================================================
+dual quaternion       ``q_r + eps q_d`` stored as ``(q_r, q_d)``, 8 numbers, both scalar
+                      first (``_xyzw`` kernels: both scalar last, scipy's default)
 exponential coords    scipy's ``RigidTransform``: ``(w, v)``, rotation first; the same
                       numbers as our twist ``(v, w)`` in the other order
 pq                    pytransform3d's pose vector ``(tx, ty, tz, qw, qx, qy, qz)``;
                       ``_xyzw``: TUM/ROS ``(tx, ty, tz, qx, qy, qz, qw)``
 ====================  ==================================================================
+
+Dual quaternions: a pose is the unit dual quaternion with real part ``q_r = q``
+and dual part ``q_d = (0, t) q / 2`` (Hamilton products). The translation is read
+back as ``t = 2 vec(q_d q_r*)``. A dual quaternion is unit when ``|q_r| = 1`` and
+``q_r . q_d = 0``. Others are normalised as scipy's
+``RigidTransform.from_dual_quat`` does: both parts are divided by ``|q_r|``, and
+the component of ``q_d`` along ``q_r`` is dropped. That component is the scalar
+part of ``q_d q_r*`` (``scal(q_d q_r*) = q_d . q_r``), so dropping it leaves ``t =
+2 vec(q_d q_r*) / |q_r|^2`` as it is: only the vector part is read.
 """
 
 from .._engine import kernel
-from .coefficients import atan_ratio, norm3
-from .quaternion import quat_apply, quat_hemisphere, quat_multiply, quat_normalize
+from .quaternion import quat_multiply, quat_normalize
 from .se3 import pose_from_twist, twist_from_pose
+from .vector import normalize4
+
+# -- dual quaternions ------------------------------------------------------------------
+
+
+@kernel(inputs=[(7,)], outputs=[(8,)])
+def dual_quat_from_pose(w, x, y, z, tx, ty, tz):
+    """Unit dual quaternion ``(q, (0, t) q / 2)`` of a pose, both parts scalar first."""
+    dw, dx, dy, dz = quat_multiply(0.0, 0.5 * tx, 0.5 * ty, 0.5 * tz, w, x, y, z)
+    return (w, x, y, z, dw, dx, dy, dz)
+
+
+@kernel(inputs=[(7,)], outputs=[(8,)])
+def dual_quat_xyzw_from_pose(w, x, y, z, tx, ty, tz):
+    """As :func:`dual_quat_from_pose`, both parts scalar last (scipy's default)."""
+    rw, rx, ry, rz, dw, dx, dy, dz = dual_quat_from_pose(w, x, y, z, tx, ty, tz)
+    return (rx, ry, rz, rw, dx, dy, dz, dw)
+
+
+@kernel(inputs=[(8,)], outputs=[(7,), ()])
+def pose_from_dual_quat(rw, rx, ry, rz, dw, dx, dy, dz):
+    """Pose of a dual quaternion (scalar first), normalised; and a validity number.
+
+    ``q = q_r / |q_r|`` and ``t = 2 vec(q_d q_r*) / |q_r|^2`` (the module docstring
+    says why this is scipy's normalisation). The second output is ``|q_r|`` plus
+    ``0 * q_d``: positive and finite exactly when ``q_r`` is nonzero and every
+    component finite (``0 * inf`` and ``0 * nan`` are NaN), so one comparison on it
+    validates the input. A zero ``q_r`` gives a zero pose, which callers reject.
+    """
+    w, x, y, z, n = normalize4(rw, rx, ry, rz)
+    safe = 2.0 / where(n > 0.0, n, 1.0)
+    # q_d / |q_r| times the unit q*: the vector part of q_d q_r* / |q_r|^2.
+    _, tx, ty, tz = quat_multiply(dw, dx, dy, dz, w, -x, -y, -z)
+    check = n + 0.0 * dw + 0.0 * dx + 0.0 * dy + 0.0 * dz
+    return (w, x, y, z, safe * tx, safe * ty, safe * tz, check)
+
+
+@kernel(inputs=[(8,)], outputs=[(7,), ()])
+def pose_from_dual_quat_xyzw(rx, ry, rz, rw, dx, dy, dz, dw):
+    """As :func:`pose_from_dual_quat`, both parts scalar last (scipy's default)."""
+    return pose_from_dual_quat(rw, rx, ry, rz, dw, dx, dy, dz)
+
+
+# -- exponential coordinates and pq -----------------------------------------------------
 
 
 @kernel(inputs=[(6,)], outputs=[(7,)])
@@ -35,7 +91,7 @@ def pose_from_pq(tx, ty, tz, qw, qx, qy, qz):
     """Pose of ``(tx, ty, tz, qw, qx, qy, qz)``, the quaternion normalised; a check.
 
     The check is ``|q| + 0 t``: positive and finite exactly when ``q`` is nonzero and
-    every component finite (as in :func:`.dual_quaternion.pose_from_dual_quat`).
+    every component finite (as in :func:`pose_from_dual_quat`).
     """
     w, x, y, z, n = quat_normalize(qw, qx, qy, qz)
     return (w, x, y, z, tx, ty, tz, n + 0.0 * tx + 0.0 * ty + 0.0 * tz)
@@ -57,42 +113,3 @@ def pq_from_pose(w, x, y, z, tx, ty, tz):
 def pq_xyzw_from_pose(w, x, y, z, tx, ty, tz):
     """TUM/ROS ``(tx, ty, tz, qx, qy, qz, qw)`` of a pose."""
     return (tx, ty, tz, x, y, z, w)
-
-
-@kernel(inputs=[(7,), (3,)], outputs=[(3,)])
-def pose_apply_inverse(w, x, y, z, tx, ty, tz, px, py, pz):
-    """The inverse motion of points, ``R^T (p - t)``, without forming the inverse."""
-    return quat_apply(w, -x, -y, -z, px - tx, py - ty, pz - tz)
-
-
-@kernel(
-    inputs=[(7,), (7,)],
-    outputs=[()],
-    params=("rotation_weight", "translation_weight"),
-)
-def pose_distance(
-    rotation_weight,
-    translation_weight,
-    w1, x1, y1, z1, tx1, ty1, tz1,
-    w2, x2, y2, z2, tx2, ty2, tz2,
-):  # fmt: skip
-    """``sqrt(a theta^2 + b |t2 - t1|^2)`` of the relative pose ``T1^-1 T2``.
-
-    ``theta`` (radians, [0, pi]) is the angle of ``R1^T R2`` (``atan2``-based, so
-    exact near 0 and pi) and ``|t2 - t1|`` is the length of the translation
-    ``R1^T (t2 - t1)`` of ``T1^-1 T2`` (a rotation keeps lengths); ``a``, ``b`` the
-    (non-negative) weights. ``theta^2`` is taken as ``|2 v atan2(|v|, w) / |v||^2``
-    (:func:`atan_ratio`), a smooth function of the quaternion ``(w, v)``: through
-    ``theta`` itself autodiff would see ``d theta / dv = 0`` at ``v = 0`` (the norm's
-    subgradient) and lose the rotation part of the Hessian where the rotations are
-    equal and the translations not. The root is taken at a safe argument, so the
-    gradient at ``T1 = T2`` is 0 (a subgradient), not NaN.
-    """
-    rw, rx, ry, rz = quat_multiply(w1, -x1, -y1, -z1, w2, x2, y2, z2)
-    rw, rx, ry, rz = quat_hemisphere(rw, rx, ry, rz)
-    k = 2.0 * atan_ratio(norm3(rx, ry, rz), rw)
-    theta2 = k * k * (rx * rx + ry * ry + rz * rz)
-    dx, dy, dz = tx2 - tx1, ty2 - ty1, tz2 - tz1
-    s = rotation_weight * theta2 + translation_weight * (dx * dx + dy * dy + dz * dz)
-    pos = s > 0.0
-    return (where(pos, sqrt(where(pos, s, 1.0)), 0.0),)

@@ -8,7 +8,7 @@ quaternion needs: inverse, exp, log and the 4x4 product matrices.
 
 from .._engine import kernel
 from .coefficients import atan_ratio, norm3, sinc
-from .rotvec import cos_of_norm
+from .so3 import cos_of_norm
 from .vector import normalize4, scaled4
 
 

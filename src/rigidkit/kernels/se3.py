@@ -1,18 +1,24 @@
 """Kernels of SE(3): poses ``(w, x, y, z, tx, ty, tz)``, twists ``(v, w)``, Jacobians.
 
 A pose is a unit quaternion (Hamilton, scalar first) followed by a translation:
-the rigid motion ``p -> R p + t``. Twists are ordered ``(v, w)`` as in the notes:
+the rigid motion ``p -> R p + t``. Here is everything SE(3) has as a group on
+poses: compose, inverse, the action on points and its inverse, a distance, exp,
+log, hat, vee, the adjoints, the bracket and the Jacobians (other layouts of a
+pose are in :mod:`.pose_formats`). Twists are ordered ``(v, w)``, translation
+first, as in Murray, Li & Sastry 1994 (Sec. 2.3) and Barfoot 2017 (Sec. 7.1):
 ``hat(V) = [[hat(w), v], [0, 0]]``, and ``exp(hat(V)) = [[R, J_l(w) v], [0, 1]]``
 with ``R = exp(hat(w))`` and ``J_l`` the SO(3) left Jacobian (a pure translation
 ``v`` when ``w = 0``). Matrices are row-major, acting on column vectors ``[p; 1]``.
 
-Jacobians follow the SO(3) convention (:mod:`.so3_jacobians`):
+Jacobians follow the SO(3) convention (:mod:`.so3`):
 ``exp(x + d) ~ exp(J_l(x) d) exp(x)`` and ``J_r(x) = J_l(-x)``; the left Jacobian of
-SE(3) is ``[[J_l(w), Q(v, w)], [0, J_l(w)]]`` with Barfoot's ``Q``.
+SE(3) is ``[[J_l(w), Q(v, w)], [0, J_l(w)]]`` with Barfoot's ``Q`` (Barfoot 2017,
+eq. 7.86).
 """
 
 from .._engine import helper, kernel
 from .coefficients import (
+    atan_ratio,
     cos_defect4,
     cot_defect2,
     norm3,
@@ -20,10 +26,17 @@ from .coefficients import (
     sin_defect3,
 )
 from .matrix import matrix_from_quat
-from .quaternion import quat_angle, quat_apply, quat_compose
-from .rotvec import half_angle_from_rotvec, rotvec_entries_from_quat
-from .so3_jacobians import (
+from .quaternion import (
+    quat_angle,
+    quat_apply,
+    quat_compose,
+    quat_hemisphere,
+    quat_multiply,
+)
+from .so3 import (
     eye_hat_hat2_apply,
+    half_angle_from_rotvec,
+    rotvec_entries_from_quat,
     so3_left_jacobian_entries,
     so3_left_jacobian_inverse_entries,
 )
@@ -126,6 +139,45 @@ def pose_apply(w, x, y, z, tx, ty, tz, px, py, pz):
     return (rx + tx, ry + ty, rz + tz)
 
 
+@kernel(inputs=[(7,), (3,)], outputs=[(3,)])
+def pose_apply_inverse(w, x, y, z, tx, ty, tz, px, py, pz):
+    """The inverse motion of points, ``R^T (p - t)``, without forming the inverse."""
+    return quat_apply(w, -x, -y, -z, px - tx, py - ty, pz - tz)
+
+
+@kernel(
+    inputs=[(7,), (7,)],
+    outputs=[()],
+    params=("rotation_weight", "translation_weight"),
+)
+def pose_distance(
+    rotation_weight,
+    translation_weight,
+    w1, x1, y1, z1, tx1, ty1, tz1,
+    w2, x2, y2, z2, tx2, ty2, tz2,
+):  # fmt: skip
+    """``sqrt(a theta^2 + b |t2 - t1|^2)`` of the relative pose ``T1^-1 T2``.
+
+    ``theta`` (radians, [0, pi]) is the angle of ``R1^T R2`` (``atan2``-based, so
+    exact near 0 and pi) and ``|t2 - t1|`` is the length of the translation
+    ``R1^T (t2 - t1)`` of ``T1^-1 T2`` (a rotation keeps lengths); ``a``, ``b`` the
+    (non-negative) weights. ``theta^2`` is taken as ``|2 v atan2(|v|, w) / |v||^2``
+    (:func:`atan_ratio`), a smooth function of the quaternion ``(w, v)``: through
+    ``theta`` itself autodiff would see ``d theta / dv = 0`` at ``v = 0`` (the norm's
+    subgradient) and lose the rotation part of the Hessian where the rotations are
+    equal and the translations not. The root is taken at a safe argument, so the
+    gradient at ``T1 = T2`` is 0 (a subgradient), not NaN.
+    """
+    rw, rx, ry, rz = quat_multiply(w1, -x1, -y1, -z1, w2, x2, y2, z2)
+    rw, rx, ry, rz = quat_hemisphere(rw, rx, ry, rz)
+    k = 2.0 * atan_ratio(norm3(rx, ry, rz), rw)
+    theta2 = k * k * (rx * rx + ry * ry + rz * rz)
+    dx, dy, dz = tx2 - tx1, ty2 - ty1, tz2 - tz1
+    s = rotation_weight * theta2 + translation_weight * (dx * dx + dy * dy + dz * dz)
+    pos = s > 0.0
+    return (where(pos, sqrt(where(pos, s, 1.0)), 0.0),)
+
+
 @kernel(inputs=[(7,)], outputs=[(7,)])
 def pose_inv(w, x, y, z, tx, ty, tz):
     """Inverse motion ``[R^T, -R^T t]``: ``(q*, -(q* t q))``."""
@@ -153,7 +205,8 @@ def pose_from_twist(vx, vy, vz, wx, wy, wz):
 
     ``J_l(w) v = v + (1 - cos t)/t^2 w x v + (t - sin t)/t^3 w x (w x v)`` with
     ``t = |w|``; the coefficient helpers carry the small-angle series, and ``w = 0``
-    gives the pure translation ``v``. This equals the errata form of DESIGN.md,
+    gives the pure translation ``v``. This equals Murray, Li & Sastry's form (1994,
+    Sec. 2.3, for a unit axis and an angle) written for ``w = theta * axis``:
     ``(I - R)(w x v)/t^2 + w w^T v / t^2``.
     """
     qw, s, theta = half_angle_from_rotvec(wx, wy, wz)

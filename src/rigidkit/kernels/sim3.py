@@ -27,7 +27,7 @@ from .._engine import helper, kernel
 from .coefficients import exprel, sinc, versinc2
 from .matrix import matrix_from_quat
 from .quaternion import quat_angle, quat_apply, quat_compose
-from .rotvec import quat_angle_from_rotvec, rotvec_entries_from_quat
+from .so3 import quat_angle_from_rotvec, rotvec_entries_from_quat
 from .vector import cross3, hat_matmul, hat_poly_apply
 
 

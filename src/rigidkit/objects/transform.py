@@ -17,7 +17,6 @@ from ..functional import conversions as _conv
 from ..functional import interpolation as _interp
 from ..functional import screw as _screw
 from ..functional import se3 as _se3
-from ..kernels import dual_quaternion as _kdq
 from ..kernels import pose_formats as _kpf
 from ..kernels import se3 as _k
 from ._batch import BatchedArray, batch_shape
@@ -222,7 +221,7 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
         >>> Transform(translation=[2.0, 0.0, 0.0]).as_dual_quat()
         array([1., 0., 0., 0., 0., 1., 0., 0.])
         """
-        kern = _kdq.dual_quat_from_pose if scalar_first else _kdq.dual_quat_xyzw_from_pose
+        kern = _kpf.dual_quat_from_pose if scalar_first else _kpf.dual_quat_xyzw_from_pose
         return kern(self._pose)
 
     def as_pq(self, *, scalar_first=True):
@@ -275,7 +274,7 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
         >>> A_T_B.apply([0.0, 0.0, 0.0], inverse=True)
         array([-1.,  0.,  0.])
         """
-        kern = _kpf.pose_apply_inverse if inverse else _k.pose_apply
+        kern = _k.pose_apply_inverse if inverse else _k.pose_apply
         return kern(self._pose, as_array(points, (3,), "points"), out=out)
 
     def inv(self):
@@ -307,7 +306,7 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
             raise TypeError(
                 f"other must be a rigidkit.Transform, got {type(other).__name__}"
             )
-        return _kpf.pose_distance(
+        return _k.pose_distance(
             _se3._weight(rotation_weight, "rotation_weight"),
             _se3._weight(translation_weight, "translation_weight"),
             self._pose,

@@ -2,8 +2,8 @@
 
 ``out[0] = x0``, ``out[k + 1] = chain(out[k], inc[k])`` along the step axis, for a
 ``chain`` kernel (``so3_chain``, ``se3_chain`` of
-:mod:`rigidkit.kernels.kinematics_integration`, ``se2_chain`` of
-:mod:`rigidkit.kernels.kinematics_planar`: associative, normalising). Two
+:mod:`rigidkit.kernels.kinematics.integration`, ``se2_chain`` of
+:mod:`rigidkit.kernels.kinematics.planar`: associative, normalising). Two
 bindings of the same kernel:
 
 * NumPy with numba: one compiled loop over trajectories and steps, generated from

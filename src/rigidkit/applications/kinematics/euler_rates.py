@@ -6,7 +6,7 @@ own order; ``omega`` in the world frame (``hat(omega) = R' R^T``) or the body fr
 UPPERCASE intrinsic (``"XYZ"`` is ``Rx(a) Ry(b) Rz(c)``), lowercase extrinsic
 (``"xyz"`` is ``Rz(c) Ry(b) Rx(a)``). The columns of ``E`` are the axes of the
 three turns, each moved by the turns before it (world) or undone by those after
-it (body); see :mod:`rigidkit.kernels.kinematics_euler`.
+it (body); see :mod:`rigidkit.kernels.kinematics.euler_rates`.
 
 ``E`` is singular at gimbal lock (a middle angle of ``+-pi/2`` for Tait-Bryan
 sequences, ``0`` or ``pi`` for proper ones): the inverse functions raise
@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 
 from ...functional.euler import gimbal_lock_threshold, parse_sequence
-from ...kernels import kinematics_euler as _k
+from ...kernels.kinematics import euler_rates as _k
 from ._common import body_flag, vector
 from ._gimbal import check_lock
 

@@ -2,7 +2,7 @@
 
 Sample ``k`` of the rate is its value at ``t_k = dt_0 + ... + dt_{k-1}``, the start
 of step ``k``; ``N`` samples give ``N`` steps and ``N + 1`` orientations (the
-first is the initial one). Methods (see :mod:`rigidkit.kernels.kinematics_integration`):
+first is the initial one). Methods (see :mod:`rigidkit.kernels.kinematics.integration`):
 
 ``"exact"``
     Zero-order hold: the rate is held over each step, ``R_{k+1} = R_k exp(w_k dt_k)``
@@ -37,8 +37,8 @@ import numpy as np
 from ..._engine.namespace import device_of, is_numpy, namespace_of
 from ..._validate import finite_array
 from ...errors import ShapeError
-from ...kernels import kinematics_integration as _k
-from ...kernels import kinematics_planar as _kp
+from ...kernels.kinematics import integration as _k
+from ...kernels.kinematics import planar as _kp
 from ...objects.rotation import Rotation
 from ...objects.transform import Transform
 from . import _scan

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from ...functional import se2 as _se2
 from ...functional import so2 as _so2
-from ...kernels import kinematics_planar as _k
+from ...kernels.kinematics import planar as _k
 from ...kernels import so2 as _kso2
 from ...objects.rotation2d import Rotation2D
 from ...objects.transform2d import Transform2D

@@ -11,7 +11,7 @@ Hamilton, scalar first: ``q' = q (0, omega_B) / 2 = (0, omega_A) q / 2``.
 
 from __future__ import annotations
 
-from ...kernels import kinematics as _k
+from ...kernels.kinematics import rotation as _k
 from ._common import body_flag, quaternion, rotation_matrix, vector
 
 __all__ = [

@@ -15,7 +15,7 @@ accelerates at ``(hat(V') + hat(V)^2) [q; 1]`` (world twists; the notes'
 from __future__ import annotations
 
 from ...functional import screw as _screw
-from ...kernels import kinematics as _k
+from ...kernels.kinematics import twist as _k
 from ._common import body_flag, homogeneous_matrix, vector
 
 __all__ = [

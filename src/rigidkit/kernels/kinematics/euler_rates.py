@@ -3,8 +3,9 @@
 ``omega = E(angles) @ d(angles)/dt`` with the angles and rates in the sequence's
 own order, ``omega`` the angular velocity in the world frame (``vee(R' R^T)``) or the
 body frame (``vee(R^T R')``). One kernel serves all 24 sequences, with the static
-parameters of :mod:`.euler` (``e1, e2, parity, proper, reverse``; matrix-product
-order ``R = R_e1(t1) R_e2(t2) R_e3(t3)``) and ``body`` (0 world, 1 body).
+parameters of :mod:`rigidkit.kernels.euler` (``e1, e2, parity, proper, reverse``;
+matrix-product order ``R = R_e1(t1) R_e2(t2) R_e3(t3)``) and ``body`` (0 world, 1
+body).
 
 Derivation. With ``a_k`` the unit axis of factor ``k`` and ``R_k`` the factor,
 ``R' R^T = t1' hat(a1) + t2' R_1 hat(a2) R_1^T + t3' R_1 R_2 hat(a3) (R_1 R_2)^T``,
@@ -28,7 +29,6 @@ body ``b2``        ``(S3, C3, 0)``        ``(0, C3, -S3)``
 body ``b3``        ``(0, 0, 1)``          ``(1, 0, 0)``
 =================  =====================  =====================
 
-(the notes' XYZ space-frame matrix, 000 D.2, is the world Tait-Bryan column set).
 ``det E = C2`` (Tait-Bryan) or ``S2`` (proper) up to sign: ``E`` is singular at
 gimbal lock, a middle angle of ``+-pi/2`` or ``0, pi``.
 
@@ -39,8 +39,8 @@ permuted coordinates the turning rates carry the parity too. ``E'`` is exact, no
 finite difference.
 """
 
-from .._engine import helper, kernel
-from .so3_jacobians import cross3  # noqa: F401  (bound by name)
+from ..._engine import helper, kernel
+from ..vector import cross3  # noqa: F401  (bound by name)
 
 
 @helper

@@ -6,7 +6,7 @@ R_k`` (world), and ``theta_k`` depends on the rate only, not on ``R_k``: the
 increments of every step are computed at once (batched, fused), and only their
 product is sequential (see :mod:`rigidkit.applications.kinematics.integration`).
 The same holds for SE(3) and twists ``(v, w)``, and for the plane (the kernels
-of SO(2) and SE(2) steps are in :mod:`.kinematics_planar`).
+of SO(2) and SE(2) steps are in :mod:`.planar`).
 
 ``theta`` per method:
 
@@ -30,11 +30,11 @@ step; a constant rate gives every method the exact ``exp(h w)`` (all brackets
 vanish).
 """
 
-from .._engine import helper, kernel
-from .quaternion import quat_multiply
-from .rotvec import quat_entries_from_rotvec
-from .se3 import bracket, pose_compose, pose_from_twist
-from .vector import hat_poly_apply, renormalize4
+from ..._engine import helper, kernel
+from ..quaternion import quat_multiply
+from ..se3 import bracket, pose_compose, pose_from_twist
+from ..so3 import quat_entries_from_rotvec
+from ..vector import hat_poly_apply, renormalize4
 
 
 @helper

@@ -1,22 +1,22 @@
 """Kernels of planar moving frames: SO(2) and SE(2) velocities, points in the plane.
 
-A planar rotation ``R(t) = exp(theta(t) J)``, ``J = [[0, -1], [1, 0]]`` (the
-notes' ``e^{J omega t}``), has ``R' = omega J R = R omega J``: SO(2) is
-commutative, so the world and body angular velocities are the same number.
+A planar rotation ``R(t) = exp(theta(t) J)``, ``J = [[0, -1], [1, 0]]``, has ``R' =
+omega J R = R omega J``: SO(2) is commutative, so the world and body angular
+velocities are the same number.
 Planar twists are ``(vx, vy, omega)``, ``hat(V) = [[omega J, v], [0, 0]]``; world
 ``T' = hat(V) T`` (``v = p' - omega J p``), body ``T' = T hat(V)`` (``v = R^T p'``).
-With ``J^2 = -I`` a body point accelerates at ``(alpha J - omega^2 I) r``, the
-notes' ``[[-omega^2, -alpha], [alpha, -omega^2]]`` (000 D.3, with ``alpha`` for
-their ``omega'``).
+With ``J^2 = -I`` a body point accelerates at ``(alpha J - omega^2 I) r =
+[[-omega^2, -alpha], [alpha, -omega^2]] r``, ``alpha = omega'`` (tangential plus
+centripetal, the planar case of ``alpha x r + omega x (omega x r)``).
 
-Integration steps (as in :mod:`.kinematics_integration`, whose RKMK4 they
+Integration steps (as in :mod:`.integration`, whose RKMK4 they
 follow): SE(2) steps are poses ``exp(theta)`` chained in order; so(2) is abelian,
 so every bracket vanishes, RKMK4 is Simpson's rule for ``theta = integral of
 omega``, and the SO(2) steps are angles, summed.
 """
 
-from .._engine import helper, kernel
-from .se2 import bracket, pose_from_twist, pose_multiply
+from ..._engine import helper, kernel
+from ..se2 import bracket, pose_from_twist, pose_multiply
 
 
 @kernel(inputs=[(2, 2), (2, 2)], outputs=[(1,)])
@@ -73,7 +73,7 @@ def point_acceleration_2d(w, a, rx, ry, aox, aoy, vrx, vry, arx, ary):
     )
 
 
-# -- integration steps (see kinematics_integration) ------------------------------------
+# -- integration steps (see integration.py) --------------------------------------------
 
 
 @kernel(inputs=[(1,), ()], outputs=[(1,)])
@@ -111,7 +111,7 @@ def se2_increment(vx, vy, w, h):
 def se2_increment_rk4(body, a0, a1, a2, m0, m1, m2, e0, e1, e2, h):
     """Pose of ``exp(theta)``, ``theta`` the RKMK4 increment in se(2).
 
-    As :func:`~rigidkit.kernels.kinematics_integration.se3_increment_rk4`, with the
+    As :func:`~rigidkit.kernels.kinematics.integration.se3_increment_rk4`, with the
     bracket of se(2).
     """
     s = where(body == 1, 1.0, -1.0)
@@ -131,7 +131,7 @@ def se2_increment_rk4(body, a0, a1, a2, m0, m1, m2, e0, e1, e2, h):
 @kernel(inputs=[(4,), (4,)], outputs=[(4,)], params=("body",))
 def se2_chain(body, c1, s1, x1, y1, c2, s2, x2, y2):
     """``A B`` (body) or ``B A`` (world) of planar poses (see
-    :func:`~rigidkit.kernels.kinematics_integration.so3_chain`); the
+    :func:`~rigidkit.kernels.kinematics.integration.so3_chain`); the
     complex part is renormalised by :func:`~rigidkit.kernels.so2.complex_multiply`."""
     b = body == 1
     return pose_multiply(
