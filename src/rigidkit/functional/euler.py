@@ -42,6 +42,7 @@ array([20., 90.,  0.])
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
@@ -439,8 +440,10 @@ def euler_from_quat_unchecked(seq, quat, *, degrees=False):
     return angles
 
 
-class EulerCall(NamedTuple):
-    """The constants of one call, memoised per ``(seq, degrees, dtype)``."""
+@dataclass(frozen=True, slots=True)
+class EulerCall:
+    """The constants of one call, memoised per ``(seq, degrees, dtype)`` (slotted,
+    as :class:`~rigidkit.functional._gimbal_lock.LockBand`, for fast reads)."""
 
     #: The parsed sequence.
     sequence: EulerSequence
