@@ -27,8 +27,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._engine.namespace import namespace_of
-from .._validate import batch_index, checks_now, to_numpy, tolerances, where_text
+from .._engine.namespace import is_float32, namespace_of
+from .._validate import batch_index, checks_now, to_numpy, where_text
 from ..errors import GimbalLockWarning
 
 __all__ = [
@@ -59,7 +59,7 @@ def gimbal_lock_threshold(dtype) -> float:
         return _THRESHOLDS[dtype]
     except (KeyError, TypeError):
         pass
-    tol = tolerances(dtype).gimbal_lock
+    tol = math.sqrt(_eps(dtype))
     try:
         _THRESHOLDS[dtype] = tol
     except TypeError:  # unhashable dtype object
@@ -68,6 +68,11 @@ def gimbal_lock_threshold(dtype) -> float:
 
 
 _THRESHOLDS: dict = {}
+
+
+def _eps(dtype) -> float:
+    """Machine epsilon of a float dtype of any namespace (float32, else float64)."""
+    return 1.1920928955078125e-07 if is_float32(dtype) else 2.220446049250313e-16
 
 
 def lock_tolerance(dtype) -> float:
@@ -87,7 +92,7 @@ def lock_tolerance(dtype) -> float:
     >>> lock_tolerance(np.float64), lock_tolerance(np.float32)
     (4.440892098500626e-16, 2.384185791015625e-07)
     """
-    return tolerances(dtype).lock
+    return 2.0 * _eps(dtype)
 
 
 @dataclass(frozen=True, slots=True)
