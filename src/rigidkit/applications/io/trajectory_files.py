@@ -32,9 +32,9 @@ import warnings
 import numpy as np
 
 from ...errors import TimestampError, TrajectoryFileError
-from ...objects.rotation import Rotation
 from ...objects.transform import Transform
 from ..trajectory.trajectory import Trajectory, check_stamps
+from ._parse import parse_table
 
 __all__ = ["FORMATS", "KITTI_ATOL", "read_trajectory", "write_trajectory"]
 
@@ -79,39 +79,36 @@ def _is_number(token: str) -> bool:
 
 
 class _Text:
-    """A file's lines, with the 1-based numbers of its data lines found lazily."""
+    """A file's bytes; its text and lines are decoded only where needed."""
 
     def __init__(self, path):
         self.path = os.fspath(path)
         try:
-            with open(self.path, encoding="utf-8") as f:
-                text = f.read()
-        except (OSError, UnicodeDecodeError) as exc:
+            with open(self.path, "rb") as f:
+                data = f.read()
+        except OSError as exc:
             reason = getattr(exc, "strerror", None) or exc
             raise TrajectoryFileError(
                 f"cannot read {self.path!r}: {reason}", path=self.path
             ) from None
-        self.text = text.removeprefix("\ufeff")
+        self.data = data.removeprefix(b"\xef\xbb\xbf")  # a byte-order mark
         self._lines = None
+
+    @property
+    def head(self) -> str:
+        """The first 64 KiB as text: enough to tell the format."""
+        return self.data[:65536].decode("utf-8", "replace")
 
     @property
     def lines(self):
         if self._lines is None:
-            self._lines = self.text.splitlines()
+            self._lines = self.data.decode("utf-8", "replace").splitlines()
         return self._lines
-
-    def data_lines(self, start=0):
-        """1-based numbers of the data lines from line ``start + 1`` on."""
-        return [
-            n
-            for n, line in enumerate(self.lines[start:], start=start + 1)
-            if not _is_skipped(line)
-        ]
 
     def first_lines(self, count=2):
         """The first ``count`` lines that are not blank (comments included)."""
         out = []
-        for n, line in enumerate(self.text.splitlines()[:200], start=1):
+        for n, line in enumerate(self.head.splitlines()[:200], start=1):
             if line.strip():
                 out.append((n, line))
                 if len(out) == count:
@@ -122,55 +119,38 @@ class _Text:
 def _table(src: _Text, delimiter, ncols: int, exact: bool, skip: int, what: str):
     """``(data, rows)``: the numbers (M, ncols) of the data lines after line ``skip``.
 
-    ``rows()`` gives the 1-based line number of each data row (computed only
-    when an error needs it). Lines with fewer fields (or, if ``exact``, more) or
-    a field that is not a number raise :class:`TrajectoryFileError`.
+    ``rows()`` gives the 1-based line number of each data row. Lines with fewer
+    fields (or, if ``exact``, more) or a field that is not a number raise
+    :class:`TrajectoryFileError`.
     """
-    data = None
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", UserWarning)  # "input contained no data"
-            data = np.loadtxt(
-                src.lines[skip:] if skip else src.text.splitlines(),
-                delimiter=delimiter,
-                comments="#",
-                ndmin=2,
-                dtype=np.float64,
-                usecols=None if exact else range(ncols),
-            )
-    except ValueError:
-        data = None
-    numbers = None
-
-    def rows():
-        nonlocal numbers
-        if numbers is None:
-            numbers = src.data_lines(skip)
-        return numbers
-
-    if data is None or (data.size and data.shape[1] != ncols) or len(data) != len(rows()):
-        _diagnose(src, delimiter, ncols, exact, rows(), what)
-    if data.size == 0:
-        data = np.zeros((0, ncols))
-    return data, rows
-
-
-def _diagnose(src, delimiter, ncols, exact, numbers, what):
-    sep = "spaces" if delimiter is None else repr(delimiter)
-    for row, n in enumerate(numbers):
-        fields = _split(src.lines[n - 1], delimiter)
-        if len(fields) < ncols or (exact and len(fields) != ncols):
+    offset = 0
+    for _ in range(skip):
+        offset = (
+            src.data.index(b"\n", offset) + 1
+            if b"\n" in src.data[offset:]
+            else len(src.data)
+        )
+    data, lines, status, line, field = parse_table(
+        src.data[offset:], ncols, exact, delimiter
+    )
+    lines += skip
+    line += skip
+    if status != "ok":
+        sep = "spaces" if delimiter is None else repr(delimiter)
+        row = len(data)
+        if status == "count":
             _fail(
                 src.path,
-                n,
-                f"{len(fields)} fields separated by {sep}, expected "
+                line,
+                f"{field} fields separated by {sep}, expected "
                 f"{ncols if exact else f'at least {ncols}'} ({what})",
                 row,
             )
-        for k, field in enumerate(fields[:ncols]):
-            if not _is_number(field):
-                _fail(src.path, n, f"field {k + 1} is {field!r}, not a number", row)
-    _fail(src.path, None, f"cannot be read as {what}")
+        fields = _split(src.lines[line - 1], delimiter)
+        token = fields[field - 1] if field <= len(fields) else ""
+        what = f"{token!r}, not a number" if token else "empty"
+        _fail(src.path, line, f"field {field} is {what}", row)
+    return data, lambda: lines
 
 
 def _check_finite(src, data, rows):
@@ -178,7 +158,8 @@ def _check_finite(src, data, rows):
     if bad.any():
         row = int(np.argmax(bad))
         k = int(np.argmax(~np.isfinite(data[row])))
-        _fail(src.path, rows()[row], f"field {k + 1} is {data[row, k]!r}, not finite", row)
+        value = float(data[row, k])
+        _fail(src.path, rows()[row], f"field {k + 1} is {value!r}, not finite", row)
 
 
 def _checked_stamps(src, stamps, rows):
@@ -191,20 +172,20 @@ def _checked_stamps(src, stamps, rows):
         _fail(
             src.path,
             rows()[row],
-            f"stamp {stamps[row]!r} {how} the previous line's {stamps[i]!r}; "
+            f"stamp {float(stamps[row])!r} {how} the previous line's {float(stamps[i])!r}; "
             "stamps must be strictly increasing",
             row,
         )
 
 
-def _poses_from_quat(src, xyz, wxyz, rows):
-    norm2 = np.einsum("ij,ij->i", wxyz, wxyz)
-    bad = ~(norm2 > 0.0)
+def _poses_from_pq(src, pq, scalar_first, rows):
+    """Poses from rows ``(x, y, z)`` and a quaternion of any nonzero norm."""
+    q = pq[:, 3:]
+    bad = ~(np.einsum("ij,ij->i", q, q) > 0.0)
     if bad.any():
         row = int(np.argmax(bad))
         _fail(src.path, rows()[row], "the quaternion has zero norm", row)
-    rotation = Rotation.from_quat(wxyz / np.sqrt(norm2)[:, None])
-    return Transform(rotation=rotation, translation=xyz)
+    return Transform.from_pq(np.ascontiguousarray(pq), scalar_first=scalar_first)
 
 
 # -- the formats -----------------------------------------------------------------------
@@ -214,7 +195,7 @@ def _read_tum(src):
     data, rows = _table(src, None, 8, True, 0, "TUM: t x y z qx qy qz qw")
     _check_finite(src, data, rows)
     stamps = _checked_stamps(src, data[:, 0], rows)
-    poses = _poses_from_quat(src, data[:, 1:4], data[:, [7, 4, 5, 6]], rows)
+    poses = _poses_from_pq(src, data[:, 1:], False, rows)
     return Trajectory._trusted(stamps, poses)
 
 
@@ -253,13 +234,13 @@ def _read_kitti(src, stamps, atol):
 
 
 def _read_euroc(src):
-    delimiter = "," if "," in src.text[:4096] else None
+    delimiter = "," if "," in src.head[:4096] else None
     data, rows = _table(
         src, delimiter, 8, False, 0, "EuRoC: t[ns] p_x p_y p_z q_w q_x q_y q_z"
     )
     _check_finite(src, data, rows)
     stamps = _checked_stamps(src, data[:, 0] / 1e9, rows)
-    poses = _poses_from_quat(src, data[:, 1:4], data[:, 4:8], rows)
+    poses = _poses_from_pq(src, data[:, 1:8], True, rows)
     return Trajectory._trusted(stamps, poses)
 
 
@@ -299,7 +280,12 @@ def _csv_delimiter(line: str):
 
 def _read_csv(src):
     first = next(
-        ((n, line) for n, line in enumerate(src.lines, start=1) if line.strip()), None
+        (
+            (n, line)
+            for n, line in enumerate(src.head.splitlines(), start=1)
+            if line.strip()
+        ),
+        None,
     )
     if first is None:
         _fail(src.path, None, "is empty; a CSV trajectory needs a header line")
@@ -348,7 +334,8 @@ def _read_csv(src):
     if "t" in found:
         t = data[:, found["t"]]
         stamps = _checked_stamps(src, t / 1e9 if ns else t, rows)
-    return Trajectory._trusted(stamps, _poses_from_quat(src, xyz, wxyz, rows))
+    pq = np.concatenate([xyz, wxyz], axis=1)
+    return Trajectory._trusted(stamps, _poses_from_pq(src, pq, True, rows))
 
 
 def _detect(src) -> str:
@@ -361,7 +348,12 @@ def _detect(src) -> str:
         if "," in low and "timestamp" in low and ("q_" in low or "qw" in low):
             return "euroc"
         data = next(
-            ((m, x) for m, x in enumerate(src.lines, start=1) if not _is_skipped(x)), None
+            (
+                (m, x)
+                for m, x in enumerate(src.head.splitlines(), start=1)
+                if not _is_skipped(x)
+            ),
+            None,
         )
         if data is None:
             _fail(src.path, None, "holds no pose (only comments)")

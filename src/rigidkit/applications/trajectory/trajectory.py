@@ -27,14 +27,15 @@ def check_stamps(stamps, n: int, what: str = "stamps") -> np.ndarray:
     bad = ~np.isfinite(t)
     if bad.any():
         i = int(np.argmax(bad))
-        raise TimestampError(f"{what}[{i}] is {t[i]!r}, not finite", index=(i,))
+        raise TimestampError(f"{what}[{i}] is {float(t[i])!r}, not finite", index=(i,))
     if n > 1:
         step = np.diff(t)
         if not (step > 0.0).all():
             i = int(np.argmax(~(step > 0.0))) + 1
             how = "repeats" if step[i - 1] == 0.0 else "goes backwards from"
             raise TimestampError(
-                f"{what}[{i}] = {t[i]!r} {how} {what}[{i - 1}] = {t[i - 1]!r}; "
+                f"{what}[{i}] = {float(t[i])!r} {how} "
+                f"{what}[{i - 1}] = {float(t[i - 1])!r}; "
                 "stamps must be strictly increasing",
                 index=(i,),
             )

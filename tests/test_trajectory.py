@@ -1,0 +1,168 @@
+"""rk.Trajectory: construction, indexing, geometry, interpolation, transforms."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import rigidkit as rk
+
+scipy_rotation = pytest.importorskip("scipy.spatial.transform")
+
+
+def _screw(t, twist):
+    """The constant-twist motion exp(t V), a closed form to interpolate."""
+    return rk.Transform.exp(np.outer(t, twist))
+
+
+def test_construction_checks_stamps_and_types():
+    poses = rk.Transform.random(3, rng=0)
+    with pytest.raises(rk.TimestampError, match=r"stamps\[2\] = 1.0 repeats"):
+        rk.Trajectory([0.0, 1.0, 1.0], poses)
+    with pytest.raises(rk.TimestampError, match="goes backwards") as info:
+        rk.Trajectory([0.0, 2.0, 1.0], poses)
+    assert info.value.index == (2,)
+    with pytest.raises(rk.TimestampError, match="not finite"):
+        rk.Trajectory([0.0, np.nan, 1.0], poses)
+    with pytest.raises(rk.ShapeError, match=r"shape \(3,\)"):
+        rk.Trajectory([0.0, 1.0], poses)
+    with pytest.raises(TypeError, match="Transform"):
+        rk.Trajectory([0.0], np.zeros((1, 7)))
+    with pytest.raises(rk.ShapeError, match="time axis"):
+        rk.Trajectory(None, rk.Transform())
+
+
+def test_is_immutable_and_copies_its_stamps():
+    stamps = np.array([0.0, 1.0])
+    traj = rk.Trajectory(stamps, rk.Transform.random(2, rng=0))
+    stamps[0] = 5.0
+    assert traj.stamps[0] == 0.0
+    with pytest.raises(ValueError):
+        traj.stamps[0] = 1.0
+    with pytest.raises(AttributeError):
+        traj.stamps = None
+
+
+def test_indexing_keeps_stamps_with_poses():
+    traj = rk.Trajectory(np.arange(6.0) * 0.5, rk.Transform.random(6, rng=1))
+    p = np.asarray(traj.positions)
+    sub = traj[1:5:2]
+    assert sub.stamps.tolist() == [0.5, 1.5]
+    np.testing.assert_array_equal(sub.positions, p[1:5:2])
+    mask = np.array([True, False, False, True, True, False])
+    np.testing.assert_array_equal(traj[mask].stamps, [0.0, 1.5, 2.0])
+    np.testing.assert_array_equal(traj[np.array([0, -1])].positions, p[[0, -1]])
+    one = traj[2]
+    assert isinstance(one, rk.Transform) and one.single
+    np.testing.assert_array_equal(one.translation, p[2])
+    with pytest.raises(rk.TimestampError):
+        traj[np.array([3, 1])]  # out of order: stamps would go backwards
+    assert len(traj) == 6 and bool(traj) and not bool(traj[:0])
+
+
+def test_path_length_duration_and_batches():
+    x = np.array([0.0, 3.0, 3.0, 0.0])
+    y = np.array([0.0, 0.0, 4.0, 0.0])
+    traj = rk.Trajectory([1.0, 2.0, 4.0, 7.0], rk.Transform(translation=np.c_[x, y, 0 * x]))
+    assert traj.path_length == 3.0 + 4.0 + 5.0
+    assert traj.duration == 6.0
+    batch = rk.Trajectory(
+        None, rk.Transform(translation=np.stack([np.c_[x, y, 0 * x]] * 2))
+    )
+    assert batch.shape == (2, 4) and len(batch) == 4
+    np.testing.assert_array_equal(batch.path_length, [12.0, 12.0])
+    with pytest.raises(rk.TimestampError):
+        _ = batch.duration
+
+
+def test_at_slerp_follows_a_screw_motion_exactly():
+    twist = np.array([1.0, -0.5, 0.2, 0.3, 0.1, -0.4])
+    t = np.array([0.0, 0.4, 1.0, 1.7, 2.0])
+    traj = rk.Trajectory(t, _screw(t, twist))
+    q = np.array([0.0, 0.1, 0.55, 1.3, 2.0])
+    got = traj.at(q)
+    assert got.stamps.tolist() == q.tolist()
+    assert bool(got.poses.approx_equal(_screw(q, twist), atol=1e-14).all())
+
+
+def test_at_linear_equals_scipy_slerp_and_np_interp():
+    rng = np.random.default_rng(2)
+    t = np.sort(rng.uniform(0, 10, 8))
+    traj = rk.Trajectory(t, rk.Transform.random(8, rng=rng))
+    q = np.sort(rng.uniform(t[0], t[-1], 20))
+    got = traj.at(q, method="linear")
+    R = scipy_rotation.Rotation.from_quat(traj.poses.rotation.as_quat(scalar_first=False))
+    expected = scipy_rotation.Slerp(t, R)(q).as_quat()
+    np.testing.assert_allclose(
+        got.poses.rotation.as_quat(scalar_first=False, canonical=True),
+        expected * np.sign(expected[:, 3:]),
+        atol=1e-14,
+    )
+    p = np.asarray(traj.positions)
+    for k in range(3):
+        np.testing.assert_allclose(
+            got.positions[:, k], np.interp(q, t, p[:, k]), atol=1e-13
+        )
+
+
+def test_at_spline_is_smooth_and_exact_on_a_screw_motion():
+    # Cubic B-splines reproduce linear functions: on uniformly sampled constant-twist
+    # motion the spline is the motion itself, away from the two end segments.
+    twist = np.array([0.5, 0.0, 0.1, 0.0, 0.2, 0.3])
+    t = np.linspace(0.0, 4.0, 9)
+    traj = rk.Trajectory(t, _screw(t, twist))
+    q = np.linspace(1.0, 3.0, 7)
+    got = traj.at(q, method="spline")
+    assert bool(got.poses.approx_equal(_screw(q, twist), atol=1e-12).all())
+    whole = traj.at(np.linspace(0.0, 4.0, 50), method="spline")
+    assert len(whole) == 50
+
+
+def test_at_outside_the_range_names_it():
+    traj = rk.Trajectory([1.0, 2.0], rk.Transform.random(2, rng=0))
+    with pytest.raises(rk.OutOfRangeError, match=r"2.5 lies outside .* \[1.0, 2.0\]"):
+        traj.at([1.5, 2.5])
+    with pytest.raises(ValueError, match="method"):
+        traj.at([1.5], method="cubic")
+
+
+def test_at_on_a_batch():
+    twist = np.array([1.0, 0.0, 0.0, 0.0, 0.0, 0.5])
+    t = np.arange(4.0)
+    poses = _screw(t, twist)
+    batch = rk.Trajectory(t, rk.Transform.from_pq(np.stack([poses.as_pq()] * 3)))
+    got = batch.at([0.5, 2.5])
+    assert got.shape == (3, 2)
+    assert bool(
+        got.poses.approx_equal(_screw(np.array([0.5, 2.5]), twist), atol=1e-14).all()
+    )
+
+
+def test_transform_by_a_similarity_scales_positions():
+    traj = rk.Trajectory([0.0, 1.0], rk.Transform.random(2, rng=3))
+    S = rk.Similarity(
+        scale=2.5, rotation=rk.Rotation.from_rotvec([0.1, 0.2, 0.3]), translation=[1, 2, 3]
+    )
+    moved = traj.transform(S)
+    M = S.as_matrix()
+    expected_p = (M[:3, :3] @ np.asarray(traj.positions).T).T + M[:3, 3]
+    np.testing.assert_allclose(moved.positions, expected_p, atol=1e-14)
+    R_S = S.rotation.as_matrix()
+    np.testing.assert_allclose(
+        moved.poses.rotation.as_matrix(), R_S @ traj.poses.rotation.as_matrix(), atol=1e-15
+    )
+    T = rk.Transform.random(rng=4)
+    np.testing.assert_allclose(
+        traj.transform(T).poses.as_matrix(),
+        T.as_matrix() @ traj.poses.as_matrix(),
+        atol=1e-14,
+    )
+
+
+def test_velocities_of_a_constant_twist():
+    twist = np.array([1.0, 0.0, 0.5, 0.0, 0.0, 0.25])
+    t = np.linspace(0.0, 2.0, 11)
+    traj = rk.Trajectory(t, _screw(t, twist))
+    np.testing.assert_allclose(
+        traj.velocities(frame="body"), np.tile(twist, (11, 1)), atol=1e-12
+    )
