@@ -42,7 +42,6 @@ array([20., 90.,  0.])
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
@@ -53,7 +52,6 @@ from ..errors import EulerSequenceError
 from ..kernels import euler as _k
 from . import conversions as _conv
 from ._gimbal_lock import (
-    LockBand,
     gimbal_lock_threshold,
     lock_band,
     lock_free,
@@ -440,23 +438,23 @@ def euler_from_quat_unchecked(seq, quat, *, degrees=False):
     return angles
 
 
-@dataclass(frozen=True, slots=True)
 class EulerCall:
-    """The constants of one call, memoised per ``(seq, degrees, dtype)`` (slotted,
-    as :class:`~rigidkit.functional._gimbal_lock.LockBand`, for fast reads)."""
+    """The constants of one call, memoised per ``(seq, degrees, dtype)``: the parsed
+    ``sequence``; ``params`` of the kernel ``euler_from_quat`` (the sequence's,
+    ``scale`` and the :func:`lock_tolerance` of the dtype); ``checked_params`` of
+    ``euler_from_quat_checked`` (``params`` and the largest accepted ``|q|``, see
+    :func:`_moderate_limit`); ``scale``, output units per radian; and the ``band``
+    of middle angles far from the lock (see :func:`lock_free`). Slots, read as fast
+    as a tuple (see :class:`~rigidkit.functional._gimbal_lock.LockBand`)."""
 
-    #: The parsed sequence.
-    sequence: EulerSequence
-    #: Parameters of the kernel ``euler_from_quat``: the sequence's, ``scale``
-    #: (output units per radian) and the :func:`lock_tolerance` of the dtype.
-    params: tuple
-    #: Parameters of ``euler_from_quat_checked``: ``params`` and the largest
-    #: accepted ``|q|`` (see :func:`_moderate_limit`).
-    checked_params: tuple
-    #: Output units per radian (1, or 180 / pi for degrees).
-    scale: float
-    #: Where the middle angles are not near the lock (see :func:`lock_free`).
-    band: LockBand
+    __slots__ = ("sequence", "params", "checked_params", "scale", "band")
+
+    def __init__(self, sequence, params, checked_params, scale, band):
+        self.sequence, self.params, self.checked_params = sequence, params, checked_params
+        self.scale, self.band = scale, band
+
+    def __repr__(self) -> str:
+        return f"EulerCall({self.sequence.text!r}, {self.scale!r}, {self.band!r})"
 
 
 _CALLS: dict = {}
