@@ -215,9 +215,9 @@ def build_rows(libs: Libs) -> list:
         )
 
     r = row("compose out=", ([4, 4], 4), True, "rot")
-    r.notes["rigidkit"] = "rk.conversions.quat_multiply(q1, q2, out=)"
+    r.notes["rigidkit"] = "rk.quaternion.multiply(q1, q2, out=)"
     r.impls["rigidkit"] = lambda d: partial(
-        rk.conversions.quat_multiply, d.q1, d.q2, out=buffer(d.q1.shape)
+        rk.quaternion.multiply, d.q1, d.q2, out=buffer(d.q1.shape)
     )
     if nq:
         r.impls["numpy-quaternion"] = batched(

@@ -22,8 +22,9 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from rigidkit.cli import ALL, main
 from scipy.spatial.transform import Rotation as SciRot
+
+from rigidkit.applications.cli import ALL, main
 
 # Unit-free numbers (quaternions, matrices, MRPs, axes): a few ulp of float64
 # from two independent float64 implementations of the same conversion.

@@ -58,7 +58,7 @@ def _group(cls_name, module_name, rot):
     if cls is None:
         return pytest.param(None, id=cls_name, marks=pytest.mark.skip(f"no rk.{cls_name}"))
     try:
-        alg = importlib.import_module(f"rigidkit.{module_name}")
+        alg = importlib.import_module(f"rigidkit.functional.{module_name}")
     except ImportError:
         alg = None
     return pytest.param(Group(cls, alg, rot), id=cls_name)

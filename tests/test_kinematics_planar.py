@@ -206,7 +206,7 @@ def test_float32_torch_and_jax(rng, torch, jnp):
 
 def test_integration_errors():
     w = np.ones((5, 1))
-    with pytest.raises(rk.FrameError, match="frame"):
+    with pytest.raises(rk.FrameKeywordError, match="frame"):
         P.integrate_angular_velocity(rk.Rotation2D.identity(), w, 0.1)
     with pytest.raises(rk.ShapeError, match=r"w\[:, None\]"):
         P.integrate_angular_velocity(

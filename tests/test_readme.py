@@ -1,7 +1,11 @@
-"""The README's Python examples run, and their results match independent references."""
+"""The README's Python examples run, and their results match independent references;
+the public names they use (``rk.so3``, ``rk.kinematics``, ...) are the modules of the
+layer folders, each with one import path (docs/architecture.md)."""
 
+import importlib
 import pathlib
 import re
+import sys
 
 import numpy as np
 import scipy.linalg as sl
@@ -41,3 +45,37 @@ def test_readme_jax_example(jax):
         np.asarray(ns["W_R_B"].as_matrix()), ref.as_matrix(), atol=1e-12
     )
     assert type(ns["W_R_B"].as_quat()).__module__.startswith("jax")
+
+
+# rk.<name> and the one import path of the module it holds.
+PUBLIC_MODULES = {
+    "conversions": "rigidkit.functional.conversions",
+    "euler": "rigidkit.functional.euler",
+    "quaternion": "rigidkit.functional.quaternion",
+    "so3": "rigidkit.functional.so3",
+    "se3": "rigidkit.functional.se3",
+    "so2": "rigidkit.functional.so2",
+    "se2": "rigidkit.functional.se2",
+    "sim3": "rigidkit.functional.sim3",
+    "symbolic": "rigidkit.applications.symbolic",
+    "kinematics": "rigidkit.applications.kinematics",
+    "jacobians": "rigidkit.applications.jacobians",
+    "cli": "rigidkit.applications.cli",
+}
+
+
+def test_each_public_module_has_one_import_path():
+    import rigidkit as rk
+
+    for name, path in PUBLIC_MODULES.items():
+        module = getattr(rk, name)
+        assert module is importlib.import_module(path), name
+        assert module.__name__ == path
+        # Not a second path: no finder makes ``rigidkit.so3`` importable.
+        try:
+            importlib.import_module(f"rigidkit.{name}")
+        except ModuleNotFoundError:
+            pass
+        else:
+            raise AssertionError(f"rigidkit.{name} is importable")
+        assert f"rigidkit.{name}" not in sys.modules

@@ -11,7 +11,7 @@ from .errors import (  # noqa: F401  (exported below as listed in errors.__all__
     ConvergenceWarning,
     DegenerateInputError,
     EulerSequenceError,
-    FrameError,
+    FrameKeywordError,
     GimbalLockError,
     GimbalLockWarning,
     NonFiniteError,
@@ -34,7 +34,9 @@ from .objects.rotation import Rotation
 from .objects.transform import Transform
 
 # The rest loads on first use, which keeps ``import rigidkit`` fast (the issue's
-# budget is 150 ms with NumPy; SymPy alone would take seconds).
+# budget is 150 ms with NumPy; SymPy alone would take seconds). A module has one
+# import path, that of its layer folder (``rigidkit.functional.so3``); ``rk.so3``
+# is the attribute holding it, not a second path: ``import rigidkit.so3`` fails.
 _LAZY = {
     "Rotation2D": ("objects.rotation2d", "Rotation2D"),
     "Transform2D": ("objects.transform2d", "Transform2D"),
@@ -57,6 +59,7 @@ _LAZY = {
     "align_points": ("applications.alignment", "align_points"),
     "kinematics": ("applications.kinematics", None),
     "jacobians": ("applications.jacobians", None),
+    "cli": ("applications.cli", None),
     "geodesic_distance": ("objects.rotation", "geodesic_distance"),
     "chordal_distance": ("objects.rotation", "chordal_distance"),
     "quat_continuous": ("functional.sequences", "quat_continuous"),
@@ -65,64 +68,6 @@ _LAZY = {
     "trajectory": ("applications.trajectory", None),
     "io": ("applications.io", None),
 }
-
-# The public module paths predate the layered tree (docs/architecture.md):
-# ``import rigidkit.so3`` keeps working and is the same module object as
-# ``rigidkit.functional.so3``.
-_MODULE_ALIASES = {
-    **{
-        name: f"functional.{name}"
-        for name in (
-            "conversions",
-            "euler",
-            "quaternion",
-            "so3",
-            "se3",
-            "so2",
-            "se2",
-            "sim3",
-        )
-    },
-    "symbolic": "applications.symbolic",
-    "kinematics": "applications.kinematics",
-    "jacobians": "applications.jacobians",
-    "cli": "applications.cli",
-}
-
-
-class _AliasFinder:
-    """Resolve ``rigidkit.<public name>`` to the module in its layer folder."""
-
-    @staticmethod
-    def find_spec(fullname, path=None, target=None):
-        prefix, _, leaf = fullname.rpartition(".")
-        if prefix != __name__ or leaf not in _MODULE_ALIASES:
-            return None
-        import importlib.util
-
-        return importlib.util.spec_from_loader(fullname, _AliasFinder)
-
-    @staticmethod
-    def create_module(spec):
-        import importlib
-
-        leaf = spec.name.rpartition(".")[2]
-        module = importlib.import_module(f"{__name__}.{_MODULE_ALIASES[leaf]}")
-        _REAL_SPECS[module.__name__] = module.__spec__
-        return module
-
-    @staticmethod
-    def exec_module(module):
-        # The import system stamped the alias spec on the real module: undo that.
-        module.__spec__ = _REAL_SPECS[module.__name__]
-
-
-_REAL_SPECS = {}
-
-
-import sys as _sys  # noqa: E402
-
-_sys.meta_path.append(_AliasFinder)
 
 __version__ = "0.1.0"
 

@@ -23,7 +23,7 @@ __all__ = [
     "TimestampError",
     "TrajectoryFileError",
     "GimbalLockError",
-    "FrameError",
+    "FrameKeywordError",
     "GimbalLockWarning",
     "ConvergenceWarning",
 ]
@@ -144,8 +144,16 @@ def _rebuild_lock_error(cls, message, index, distance, tolerance):
     return cls(message, index=index, distance=distance, tolerance=tolerance)
 
 
-class FrameError(RigidkitError):
-    """A velocity's frame is missing or not one of ``"world"`` and ``"body"``."""
+class FrameKeywordError(RigidkitError):
+    """The ``frame=`` keyword of a velocity is missing or not ``"world"`` or ``"body"``.
+
+    A velocity (angular, twist, spline derivative) means nothing without the axes
+    it is expressed in, so the functions that take one have no default. The error
+    is about that keyword only, not about coordinate frames in general.
+
+    >>> issubclass(FrameKeywordError, ValueError)
+    True
+    """
 
 
 class OutOfRangeError(RigidkitError):

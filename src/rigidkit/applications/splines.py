@@ -18,7 +18,7 @@ is required for orders 1 and 2.
 
 from __future__ import annotations
 
-from ..errors import FrameError
+from ..errors import FrameKeywordError
 from ..functional import splines as _fs
 from ..objects.rotation import Rotation
 from ..objects.transform import Transform
@@ -31,7 +31,7 @@ def _check_order(order, frame):
     if order not in (0, 1, 2):
         raise ValueError(f"order must be 0, 1 or 2, got {order!r}")
     if order and frame not in ("body", "world"):
-        raise FrameError(
+        raise FrameKeywordError(
             f"order {order} needs frame='body' (R^T dR/dt, scipy's) or frame='world' "
             f"(dR/dt R^T), got frame={frame!r}"
         )
@@ -57,7 +57,7 @@ class _Spline:
             Within ``[t_min, t_max]``, else :class:`~rigidkit.OutOfRangeError`.
         order : {0, 1, 2}
         frame : {"body", "world"}
-            Required for orders 1 and 2 (:class:`~rigidkit.FrameError` otherwise).
+            Required for orders 1 and 2 (:class:`~rigidkit.FrameKeywordError` otherwise).
 
         Returns
         -------

@@ -23,11 +23,12 @@ import math
 import os
 import sys
 import warnings
+from typing import NamedTuple
 
 import numpy as np
 
-from .._engine.namespace import is_float32, namespace_of
-from .._validate import batch_index, checks_now, to_numpy, where_text
+from .._engine.namespace import namespace_of
+from .._validate import batch_index, checks_now, to_numpy, tolerances, where_text
 from ..errors import GimbalLockWarning
 
 __all__ = [
@@ -58,7 +59,7 @@ def gimbal_lock_threshold(dtype) -> float:
         return _THRESHOLDS[dtype]
     except (KeyError, TypeError):
         pass
-    tol = math.sqrt(_eps(dtype))
+    tol = tolerances(dtype).gimbal_lock
     try:
         _THRESHOLDS[dtype] = tol
     except TypeError:  # unhashable dtype object
@@ -67,11 +68,6 @@ def gimbal_lock_threshold(dtype) -> float:
 
 
 _THRESHOLDS: dict = {}
-
-
-def _eps(dtype) -> float:
-    """Machine epsilon of a float dtype of any namespace (float32, else float64)."""
-    return 1.1920928955078125e-07 if is_float32(dtype) else 2.220446049250313e-16
 
 
 def lock_tolerance(dtype) -> float:
@@ -91,29 +87,17 @@ def lock_tolerance(dtype) -> float:
     >>> lock_tolerance(np.float64), lock_tolerance(np.float32)
     (4.440892098500626e-16, 2.384185791015625e-07)
     """
-    return 2.0 * _eps(dtype)
+    return tolerances(dtype).lock
 
 
-class LockBand:
+class LockBand(NamedTuple):
     """Where a middle angle is not near the lock: in ``[lo, hi]``, i.e. ``|mid -
-    center| <= width``, in the angles' units (see :func:`lock_band`).
+    center| <= width``, in the angles' units (see :func:`lock_band`)."""
 
-    A record with slots, not a ``NamedTuple``: its fields are read on every call,
-    and a slot is read as fast as a tuple index (a ``NamedTuple`` field ~30 ns
-    slower on CPython 3.11); not a dataclass, whose import would cost
-    ``import rigidkit`` ~20 ms.
-    """
-
-    __slots__ = ("lo", "hi", "center", "width")
-
-    def __init__(self, lo: float, hi: float, center: float, width: float):
-        self.lo, self.hi, self.center, self.width = lo, hi, center, width
-
-    def __repr__(self) -> str:
-        return (
-            f"LockBand(lo={self.lo!r}, hi={self.hi!r}, center={self.center!r}, "
-            f"width={self.width!r})"
-        )
+    lo: float
+    hi: float
+    center: float
+    width: float
 
 
 def lock_band(proper: bool, scale: float, dtype) -> LockBand:

@@ -31,7 +31,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._engine import dask_backend
-from .._engine.namespace import device_of, is_float32, namespace_of
+from .._engine.namespace import device_of, namespace_of
 from .._validate import (
     _relabel,
     any_true,
@@ -39,6 +39,7 @@ from .._validate import (
     batch_index,
     finite_array,
     to_numpy,
+    tolerances,
     where_text,
 )
 from ..errors import DegenerateInputError, ShapeError
@@ -48,9 +49,6 @@ from ..kernels import quaternion as _kq
 
 __all__ = ["kabsch", "umeyama"]
 
-_EPS64 = float(np.finfo(np.float64).eps)
-_EPS32 = float(np.finfo(np.float32).eps)
-
 
 def rank_rtol(dtype) -> float:
     """``sigma_2 / sigma_1`` below which a cross-covariance counts as rank 1: 64 eps.
@@ -59,12 +57,12 @@ def rank_rtol(dtype) -> float:
     ``eps sigma_1 / sigma_2``, radians), so the rotation about the first one is
     not determined by the data.
     """
-    return 64.0 * (_EPS32 if is_float32(dtype) else _EPS64)
+    return tolerances(dtype).rank_rtol
 
 
 def _half_turn_tiny(dtype) -> float:
     """``|u + v|^2 / 2`` below which unit ``u``, ``v`` count as antiparallel (64 eps)."""
-    e = 64.0 * (_EPS32 if is_float32(dtype) else _EPS64)
+    e = tolerances(dtype).rank_rtol
     return 0.5 * e * e
 
 

@@ -45,8 +45,15 @@ import numpy as np
 
 from .._engine import dask_backend
 from .._engine import numba_backend as _numba_backend
-from .._engine.namespace import device_of, is_float32, namespace_of
-from .._validate import _relabel, any_true, batch_index, finite_array, where_text
+from .._engine.namespace import device_of, namespace_of
+from .._validate import (
+    _relabel,
+    any_true,
+    batch_index,
+    finite_array,
+    tolerances,
+    where_text,
+)
 from ..errors import ConvergenceWarning, DegenerateInputError
 from ..kernels import quaternion as _kq
 from ..kernels import se3 as _kse3
@@ -60,10 +67,6 @@ __all__ = [
     "pose_mean_unchecked",
     "reduce_axes",
 ]
-
-#: Default Karcher tolerance on the norm of the mean log (radians; length units).
-GEODESIC_TOL = 1e-12
-GEODESIC_TOL_32 = 1e-6  # float32 cannot represent a mean log below ~1e-7
 
 
 def reduce_axes(axis, nbatch):
@@ -512,7 +515,7 @@ def _average(xp, x, w, total):
 def _tol(tol, dtype):
     if tol is not None:
         return float(tol)
-    return GEODESIC_TOL_32 if is_float32(dtype) else GEODESIC_TOL
+    return tolerances(dtype).mean_tol
 
 
 def _converged(xp, step, tol) -> bool:

@@ -9,11 +9,11 @@ a rotation, as in :meth:`rigidkit.Rotation.from_quat`), and a zero or non-finite
 one raises :class:`~rigidkit.ZeroNormError` or :class:`~rigidkit.NonFiniteError`
 naming its batch index.
 
-``quat_multiply``, ``quat_conjugate`` and ``quat_canonical`` are quaternion
-algebra, defined for every quaternion: they take it as it is (no normalisation),
-so the product of unit quaternions stays the bare kernel call. ``quat_compose``
-is that product as the composition of rotations (``q2`` first), renormalised so
-that long chains of compositions stay unit to a few ulp (``Rotation @`` uses it).
+``quat_conjugate`` and ``quat_canonical`` are quaternion algebra, defined for
+every quaternion: they take it as it is (no normalisation). ``quat_compose`` is
+the Hamilton product (:func:`rigidkit.quaternion.multiply`, the bare kernel call)
+as the composition of rotations (``q2`` first), renormalised so that long chains
+of compositions stay unit to a few ulp (``Rotation @`` uses it).
 
 Unchecked variants: ``matrix_from_quat_unchecked``, ``rotvec_from_quat_unchecked``,
 ``mrp_from_quat_unchecked``, ``axis_angle_from_quat_unchecked``,
@@ -61,7 +61,6 @@ from ..kernels import so3 as _rv
 __all__ = [
     "quat_normalize",
     "quat_canonical",
-    "quat_multiply",
     "quat_compose",
     "quat_conjugate",
     "quat_apply",
@@ -80,7 +79,6 @@ __all__ = [
     "default_atol",
 ]
 
-quat_multiply = _q.quat_multiply
 quat_compose = _q.quat_compose  # the product as composition of rotations: renormalised
 quat_conjugate = _q.quat_conjugate
 quat_canonical = _q.quat_canonical

@@ -42,6 +42,7 @@ from .._validate import (
     checks_now,
     finite_array,
     raise_where,
+    tolerances,
 )
 from ..errors import EulerSequenceError, ShapeError, ZeroNormError
 from ..kernels import davenport as _k
@@ -49,15 +50,11 @@ from . import euler as _euler
 from ._gimbal_lock import warn_if_locked
 
 __all__ = [
-    "ORTHOGONALITY_TOL",
     "LOCK_FACTOR",
     "quat_from_davenport",
     "davenport_from_quat",
     "davenport_from_quat_unchecked",
 ]
-
-#: Largest accepted ``|n_i . n_i+1|`` of consecutive unit axes (scipy's 1e-7).
-ORTHOGONALITY_TOL = 1e-7
 
 #: The lock tolerance (how far the rotation may move to return the third angle 0)
 #: in units of Euler's :func:`rigidkit.euler.lock_tolerance` (2 eps). A quaternion
@@ -108,12 +105,13 @@ def _unit_axes(axes, *, exactly3, like=None):
     if n > 1:
         xp = namespace_of(unit)
         dots = xp.sum(unit[..., :-1, :] * unit[..., 1:, :], axis=-1)
-        bad = xp.abs(dots) > ORTHOGONALITY_TOL
+        tol = tolerances(dots.dtype).axis_orthogonality  # scipy's 1e-7, any dtype
+        bad = xp.abs(dots) > tol
         raise_where(
             bad,
             EulerSequenceError,
             "Davenport axes {where} are not orthogonal: consecutive axes must be "
-            f"(|n_i . n_i+1| <= {ORTHOGONALITY_TOL:g} once normalised; the last "
+            f"(|n_i . n_i+1| <= {tol:g} once normalised; the last "
             "index is the position of the first of the two)",
         )
     return unit, n, bad

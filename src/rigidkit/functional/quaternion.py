@@ -13,8 +13,14 @@ The functions take and return arrays of shape (..., 4), batched over leading axe
 >>> import numpy as np
 >>> multiply([0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0])   # ij = k
 array([0., 0., 0., 1.])
+>>> multiply([0.0, 0.0, 1.0, 0.0], [0.0, 1.0, 0.0, 0.0])   # ji = -k: not commutative
+array([ 0.,  0.,  0., -1.])
 >>> multiply([0.0, 1.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0])   # i^2 = -1
 array([-1.,  0.,  0.,  0.])
+
+:func:`multiply` is the product kernel itself, ``q1 q2 = (w1 w2 - v1.v2, w1 v2 +
+w2 v1 + v1 x v2)`` for shapes (..., 4) broadcasting, with the kernels' ``out=``
+(a NumPy buffer of the result's shape): the one name of the Hamilton product.
 """
 
 from __future__ import annotations
@@ -49,15 +55,9 @@ def _reject_zero(result, largest, what):
     return result
 
 
-def multiply(q1, q2):
-    """Hamilton product ``q1 q2``, shapes (..., 4) broadcasting.
-
-    ``q1 q2 = (w1 w2 - v1.v2, w1 v2 + w2 v1 + v1 x v2)``; not commutative.
-
-    >>> multiply([0.0, 0.0, 1.0, 0.0], [0.0, 1.0, 0.0, 0.0])   # ji = -k
-    array([ 0.,  0.,  0., -1.])
-    """
-    return _kq.quat_multiply(_quat(q1), _quat(q2))
+# The Hamilton product of any quaternions (module docs): the kernel itself, so that a
+# call costs no Python frame beyond the kernel's fast entry and takes ``out=``.
+multiply = _kq.quat_multiply
 
 
 def conjugate(q):

@@ -19,8 +19,7 @@ array([1., 0., 0., 0.])
 
 from __future__ import annotations
 
-from .._engine.namespace import is_float32
-from .._validate import finite_array, raise_where
+from .._validate import finite_array, raise_where, tolerances
 from ..errors import DegenerateInputError
 from ..kernels import rot6d as _k
 from .conversions import quat_normalize
@@ -81,9 +80,8 @@ def quat_from_rot6d(rot6d):
     """
     x = finite_array(rot6d, (6,), "6D rotation")
     q, sine = _k.quat_from_rot6d(x)
-    eps = 1.1920928955078125e-07 if is_float32(x.dtype) else 2.220446049250313e-16
     raise_where(
-        sine <= 16.0 * eps,
+        sine <= tolerances(x.dtype).parallel_sine,
         DegenerateInputError,
         "6D rotation {where}: its two vectors are zero or parallel (sine of their "
         "angle {value:.3g}), so Gram-Schmidt determines no rotation",

@@ -39,7 +39,8 @@ import warnings
 import numpy as np
 
 from .._engine import dask_backend
-from .._engine.namespace import device_of, is_float32, namespace_of
+from .._engine.namespace import device_of, namespace_of
+from .._validate import tolerances
 from ..errors import ConvergenceWarning
 from ..kernels import quaternion as _kq
 from ..kernels import se3 as _kse3
@@ -165,7 +166,7 @@ def rotation_spline_coefficients(times, quats, *, max_iter=50):
         w = xp.stack(omega[1:-1], axis=0)
         first, last = omega[0], omega[-1]
         scale = float(xp.max(xp.abs(rates)))
-        eps = float(np.finfo(np.float32 if is_float32(theta.dtype) else np.float64).eps)
+        done = tolerances(theta.dtype).newton_rtol
         prev = math.inf
         for iterations in range(1, max_iter + 1):  # noqa: B007 (the count is returned)
             full = xp.concat([first[None], w, last[None]], axis=0)
@@ -192,7 +193,7 @@ def rotation_spline_coefficients(times, quats, *, max_iter=50):
             size = float(xp.max(xp.abs(step)))
             ref = max(float(xp.max(xp.abs(w))), scale, 1e-300)
             # Done at rounding level, or when Newton stops contracting there.
-            if size <= 16.0 * eps * ref or (size > 0.5 * prev and size < 1e-8 * ref):
+            if size <= done * ref or (size > 0.5 * prev and size < 1e-8 * ref):
                 break
             prev = size
         else:

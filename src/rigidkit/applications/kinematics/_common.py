@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ..._validate import finite_array
-from ...errors import FrameError
+from ...errors import FrameKeywordError
 from ...functional import conversions as _conv
 from ...functional import se3 as _se3
 from ...objects.rotation import Rotation
@@ -16,7 +16,7 @@ _FRAMES = (
 
 
 def body_flag(frame, fn: str) -> int:
-    """1 for ``frame="body"``, 0 for ``"world"``; :class:`FrameError` otherwise.
+    """1 for ``frame="body"``, 0 for ``"world"``; :class:`FrameKeywordError` otherwise.
 
     A velocity without its frame is ambiguous (``omega_world = R omega_body``), so
     the keyword has no default.
@@ -26,8 +26,8 @@ def body_flag(frame, fn: str) -> int:
     if frame == "body":
         return 1
     if frame is None:
-        raise FrameError(f"{fn}: the keyword frame= is required: {_FRAMES}")
-    raise FrameError(f"{fn}: frame must be {_FRAMES}; got {frame!r}")
+        raise FrameKeywordError(f"{fn}: the keyword frame= is required: {_FRAMES}")
+    raise FrameKeywordError(f"{fn}: frame must be {_FRAMES}; got {frame!r}")
 
 
 def _matrix(x, cls, trail, what, check):

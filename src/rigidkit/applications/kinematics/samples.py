@@ -27,6 +27,7 @@ from ..._engine.namespace import device_of, is_numpy, namespace_of
 from ..._validate import finite_array
 from ...errors import DegenerateInputError, ShapeError
 from ...functional import conversions as _conv
+from ...functional import quaternion as _fq
 from ...kernels import se3 as _se3
 from ...objects.rotation import Rotation
 from ...objects.transform import Transform
@@ -124,9 +125,9 @@ def angular_velocity_from_samples(rotations, times, *, frame=None):
     a, b = q[..., :-1, :], q[..., 1:, :]
     # body: q_k* q_{k+1}; world: q_{k+1} q_k*
     rel = (
-        _conv.quat_multiply(_conv.quat_conjugate(a), b)
+        _fq.multiply(_conv.quat_conjugate(a), b)
         if body
-        else _conv.quat_multiply(b, _conv.quat_conjugate(a))
+        else _fq.multiply(b, _conv.quat_conjugate(a))
     )
     d = _conv.rotvec_from_quat(rel) / h[..., None]
     if not body or n < 3:
