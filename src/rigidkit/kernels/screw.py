@@ -1,9 +1,10 @@
 """Kernels of screws: the axis, pitch and magnitude of a twist, and back.
 
-Chasles: every twist ``V = (v, w)`` with ``w != 0`` is a turn about an axis
-(through ``q``, direction ``u = w / |w|``) at rate ``|w|``, combined with a slide
-along it at ``h |w|``: ``v = -w x q + h w``. Then ``h = w . v / |w|^2`` (the pitch,
-length per radian) and the axis point nearest the origin is ``q = w x v / |w|^2``.
+Chasles (Murray, Li & Sastry 1994, Sec. 2.3.3): every twist ``V = (v, w)`` with
+``w != 0`` is a turn about an axis (through ``q``, direction ``u = w / |w|``) at
+rate ``|w|``, combined with a slide along it at ``h |w|``: ``v = -w x q + h w``.
+Then ``h = w . v / |w|^2`` (the pitch, length per radian) and the axis point
+nearest the origin is ``q = w x v / |w|^2``.
 A twist with ``w = 0`` is a pure translation: pitch infinite, direction
 ``v / |v|``, magnitude ``|v|``, axis through the origin. The zero twist gets the
 direction ``+x`` (as the identity's rotation axis) and magnitude 0.
