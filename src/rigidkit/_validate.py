@@ -24,7 +24,6 @@ points contains NaN or infinity at batch index (1,) (1,)
 
 from __future__ import annotations
 
-import dataclasses
 import math
 
 import numpy as np
@@ -324,72 +323,104 @@ def as_float(a):
 # -- default tolerances: one table per dtype ---------------------------------------------
 
 
-@dataclasses.dataclass(frozen=True, slots=True)
 class Tolerances:
     """Machine epsilon and the default tolerances of one floating dtype.
 
-    Every default tolerance of rigidkit is a field here, defined once per dtype;
-    the function that applies it documents why it has that value. A slotted
-    dataclass: its fields are read on every call, and a slot is read ~20 ns faster
-    than a ``NamedTuple`` field on CPython 3.11.
+    Every default tolerance of rigidkit is an attribute here, defined once per
+    dtype; the function that applies it documents why it has that value. A
+    read-only record with slots: its fields are read on every call, and a slot is
+    read as fast as a tuple index (a ``NamedTuple`` field ~20 ns slower on CPython
+    3.11); not a dataclass, whose import would cost ``import rigidkit`` ~20 ms.
+
+    Attributes
+    ----------
+    eps : float
+        Machine epsilon: the spacing of the dtype's numbers just above 1.
+    atol : float
+        Largest ``max(|R^T R - I|, |det R - 1|)`` of a group member
+        (:func:`default_atol`).
+    singular_rtol : float
+        Hadamard ratio at or below which a matrix is singular (:func:`singular_rtol`).
+    infinity_rtol : float
+        ``|w| / max |x, y, z, w|`` at or below which a point is at infinity, 64 eps
+        (:func:`infinity_rtol`).
+    rank_rtol : float
+        ``sigma_2 / sigma_1`` at or below which a cross-covariance has rank 1, 64 eps
+        (:func:`rigidkit.functional.alignment.rank_rtol`).
+    parallel_sine : float
+        Sine of the angle of a 6D rotation's two vectors at or below which they
+        are parallel, 16 eps (:func:`rigidkit.functional.rot6d.quat_from_rot6d`).
+    newton_rtol : float
+        Newton step of the rotation spline's solve, relative to the rates, at or
+        below which it has converged, 16 eps (:mod:`rigidkit.functional.splines`).
+    mean_tol : float
+        Norm of the mean log at or below which a Karcher mean has converged
+        (radians; length units), :mod:`rigidkit.functional.averaging`.
+    axis_orthogonality : float
+        Largest ``|n_i . n_i+1|`` of consecutive unit Davenport axes (scipy's
+        1e-7), :mod:`rigidkit.functional.davenport`.
+    lock : float
+        Radians the rotation may move to return the Euler lock convention, 2 eps
+        (:func:`rigidkit.euler.lock_tolerance`).
+    gimbal_lock : float
+        Distance (radians) of the middle Euler angle from the lock below which we
+        warn, ``sqrt(eps)`` (:func:`rigidkit.euler.gimbal_lock_threshold`).
     """
 
-    #: Machine epsilon: the spacing of the dtype's numbers just above 1.
-    eps: float
-    #: Largest ``max(|R^T R - I|, |det R - 1|)`` of a group member (:func:`default_atol`).
-    atol: float
-    #: Hadamard ratio at or below which a matrix is singular (:func:`singular_rtol`).
-    singular_rtol: float
-    #: ``|w| / max |x, y, z, w|`` at or below which a point is at infinity, 64 eps
-    #: (:func:`infinity_rtol`).
-    infinity_rtol: float
-    #: ``sigma_2 / sigma_1`` at or below which a cross-covariance has rank 1, 64 eps
-    #: (:func:`rigidkit.functional.alignment.rank_rtol`).
-    rank_rtol: float
-    #: Sine of the angle of a 6D rotation's two vectors at or below which they are
-    #: parallel, 16 eps (:func:`rigidkit.functional.rot6d.quat_from_rot6d`).
-    parallel_sine: float
-    #: Newton step of the rotation spline's solve, relative to the rates, at or
-    #: below which it has converged, 16 eps (:mod:`rigidkit.functional.splines`).
-    newton_rtol: float
-    #: Norm of the mean log at or below which a Karcher mean has converged
-    #: (radians; length units), :mod:`rigidkit.functional.averaging`.
-    mean_tol: float
-    #: Largest ``|n_i . n_i+1|`` of consecutive unit Davenport axes (scipy's 1e-7),
-    #: :mod:`rigidkit.functional.davenport`.
-    axis_orthogonality: float
-    #: Radians the rotation may move to return the Euler lock convention, 2 eps
-    #: (:func:`rigidkit.euler.lock_tolerance`).
-    lock: float
-    #: Distance (radians) of the middle Euler angle from the lock below which we
-    #: warn, ``sqrt(eps)`` (:func:`rigidkit.euler.gimbal_lock_threshold`).
-    gimbal_lock: float
-
-
-def _table(eps, *, atol, singular_rtol, mean_tol):
-    return Tolerances(
-        eps=eps,
-        atol=atol,
-        singular_rtol=singular_rtol,
-        infinity_rtol=64.0 * eps,
-        rank_rtol=64.0 * eps,
-        parallel_sine=16.0 * eps,
-        newton_rtol=16.0 * eps,
-        mean_tol=mean_tol,
-        axis_orthogonality=1e-7,
-        lock=2.0 * eps,
-        gimbal_lock=math.sqrt(eps),
+    __slots__ = (
+        "eps",
+        "atol",
+        "singular_rtol",
+        "infinity_rtol",
+        "rank_rtol",
+        "parallel_sine",
+        "newton_rtol",
+        "mean_tol",
+        "axis_orthogonality",
+        "lock",
+        "gimbal_lock",
     )
 
+    def __init__(self, eps: float, *, atol: float, singular_rtol: float, mean_tol: float):
+        fields = {
+            "eps": eps,
+            "atol": atol,
+            "singular_rtol": singular_rtol,
+            "infinity_rtol": 64.0 * eps,
+            "rank_rtol": 64.0 * eps,
+            "parallel_sine": 16.0 * eps,
+            "newton_rtol": 16.0 * eps,
+            "mean_tol": mean_tol,
+            "axis_orthogonality": 1e-7,
+            "lock": 2.0 * eps,
+            "gimbal_lock": math.sqrt(eps),
+        }
+        for name, value in fields.items():
+            object.__setattr__(self, name, value)
 
-FLOAT64 = _table(2.220446049250313e-16, atol=1e-5, singular_rtol=1e-12, mean_tol=1e-12)
+    def __setattr__(self, name, value):
+        raise AttributeError("a row of the tolerance table is read-only")
+
+    def replace(self, **changes) -> Tolerances:
+        """A copy of this row with the given fields changed."""
+        new = object.__new__(Tolerances)
+        for name in self.__slots__:
+            object.__setattr__(new, name, changes.get(name, getattr(self, name)))
+        return new
+
+    def __repr__(self) -> str:
+        inner = ", ".join(f"{name}={getattr(self, name)!r}" for name in self.__slots__)
+        return f"Tolerances({inner})"
+
+
+FLOAT64 = Tolerances(2.220446049250313e-16, atol=1e-5, singular_rtol=1e-12, mean_tol=1e-12)
 # float32 cannot represent a mean log below ~1e-7, hence its Karcher tolerance.
-FLOAT32 = _table(1.1920928955078125e-07, atol=1e-4, singular_rtol=1e-5, mean_tol=1e-6)
+FLOAT32 = Tolerances(1.1920928955078125e-07, atol=1e-4, singular_rtol=1e-5, mean_tol=1e-6)
 # Half precision (computed in float32, returned in its own dtype) has its own
 # membership tolerance, the rounding of its entries (see default_atol); its other
-# rows are float64's.
-FLOAT16 = dataclasses.replace(FLOAT64, atol=4e-3)
-BFLOAT16 = dataclasses.replace(FLOAT64, atol=3e-2)
+# fields are float64's.
+FLOAT16 = FLOAT64.replace(atol=4e-3)
+BFLOAT16 = FLOAT64.replace(atol=3e-2)
 
 
 def tolerances(dtype) -> Tolerances:
