@@ -473,6 +473,56 @@ def test_every_indexed_raise_passes_index():
     assert missing == []
 
 
+# -- messages print numbers as numbers ---------------------------------------------------
+# NumPy 2 writes repr(np.float64(2.0)) as "np.float64(2.0)"; a message shows "2.0".
+NUMBER_MESSAGES = {
+    "times not increasing": (
+        rk.DegenerateInputError,
+        lambda: rk.Slerp(np.array([0.0, 2.0, 1.0]), rk.Rotation.identity(3)),
+        "times[2] = 1.0 <= times[1] = 2.0",
+    ),
+    "slerp query out of range": (
+        rk.OutOfRangeError,
+        lambda: rk.Slerp(np.array([0.0, 1.0, 2.0]), rk.Rotation.identity(3))(
+            np.array([5.0])
+        ),
+        "time 5.0 at index (0,) is outside the interpolation range [0.0, 2.0]",
+    ),
+    "spline query out of range": (
+        rk.OutOfRangeError,
+        lambda: rk.RotationSpline(np.array([0.0, 1.0]), rk.Rotation.identity(2))(
+            np.array([-0.5])
+        ),
+        "time -0.5 at index (0,) is outside the interpolation range [0.0, 1.0]",
+    ),
+    "NumPy scalar scale": (
+        rk.NotASimilarityError,
+        lambda: rk.Similarity(scale=np.float64(-2.0)),
+        "got -2.0",
+    ),
+    "bad frame": (
+        rk.FrameKeywordError,
+        lambda: rk.kinematics.euler_rate_matrix("ZYX", np.zeros(3), frame="space"),
+        "got 'space'",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", sorted(NUMBER_MESSAGES))
+def test_messages_print_plain_numbers(case):
+    exc, fn, text = NUMBER_MESSAGES[case]
+    message = _raises(exc, fn, text)
+    assert "np." not in message
+
+
+@pytest.mark.parametrize("case", sorted(INDEXED_ERRORS))
+def test_indexed_messages_print_plain_numbers(case):
+    exc, fn = INDEXED_ERRORS[case]
+    with pytest.raises(exc) as info:
+        fn()
+    assert "np." not in str(info.value)
+
+
 # -- functional conversions validate like the classes ----------------------------------
 def test_functional_conversions_normalise_the_quaternion():
     q = np.array([[2.0, 0.0, 0.0, 0.0], [0.5, -1.0, 2.0, -3.0]])

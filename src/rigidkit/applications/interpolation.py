@@ -107,8 +107,8 @@ def keyframe_times(times, count, what="keyframes"):
     if bad.size:
         k = int(bad[0]) + 1
         raise DegenerateInputError(
-            f"times must be strictly increasing: times[{k}] = {t[k]!r} <= "
-            f"times[{k - 1}] = {t[k - 1]!r}",
+            f"times must be strictly increasing: times[{k}] = {float(t[k])!r} <= "
+            f"times[{k - 1}] = {float(t[k - 1])!r}",
             index=(k,),
         )
     return t
@@ -121,8 +121,8 @@ def query_times(times, lo, hi):
     if out.any():
         idx = tuple(int(i) for i in np.argwhere(out)[0])
         raise OutOfRangeError(
-            f"time {q[idx]!r} {'at index ' + str(idx) + ' ' if idx else ''}is outside "
-            f"the interpolation range [{lo!r}, {hi!r}]",
+            f"time {float(q[idx])!r} {'at index ' + str(idx) + ' ' if idx else ''}is "
+            f"outside the interpolation range [{float(lo)!r}, {float(hi)!r}]",
             index=idx,
         )
     return q

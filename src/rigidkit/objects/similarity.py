@@ -242,7 +242,7 @@ class Similarity(BatchedArray, LieGroup, family="space", rank=2):
 def _check_positive(s):
     if isinstance(s, (int, float)):
         if not s > 0:
-            raise NotASimilarityError(f"scale must be positive, got {s!r}")
+            raise NotASimilarityError(f"scale must be positive, got {float(s)!r}")
         return
     raise_where(
         ~(s > 0),
