@@ -166,3 +166,22 @@ def test_velocities_of_a_constant_twist():
     np.testing.assert_allclose(
         traj.velocities(frame="body"), np.tile(twist, (11, 1)), atol=1e-12
     )
+
+
+def test_plot_functions_draw_on_new_or_given_axes():
+    pytest.importorskip("matplotlib")
+    t = np.linspace(0.0, 2.0, 20)
+    traj = rk.Trajectory(t, _screw(t, np.array([1.0, 0.0, 0.2, 0.0, 0.0, 1.0])))
+    ax = rk.trajectory.plot(
+        [traj, traj.transform(rk.Transform(translation=[0, 1, 0]))], labels=["a", "b"]
+    )
+    assert len(ax.lines) == 2 and ax.get_legend() is not None
+    ax3 = rk.trajectory.plot(traj, plane="3d")
+    assert ax3.name == "3d"
+    result = rk.trajectory.ape(traj, traj.transform(rk.Transform(translation=[0, 0, 0.1])))
+    ax = rk.trajectory.plot_errors(result)
+    np.testing.assert_allclose(ax.lines[0].get_ydata(), result.errors)
+    ax = rk.trajectory.plot_error_colored(traj, result.errors, plane="xz")
+    assert len(ax.collections) == 1
+    with pytest.raises(ValueError, match="plane"):
+        rk.trajectory.plot(traj, plane="xyz")

@@ -352,3 +352,80 @@ def test_align_batched_equals_one_by_one():
             np.testing.assert_allclose(aligned.positions[k], one.positions, atol=1e-12)
         errors = ape(ref, aligned).errors
         assert errors.shape == (3, 30)
+
+
+# -- KITTI -----------------------------------------------------------------------------
+
+
+def _devkit_reference(gt, est, lengths, step):
+    """The KITTI odometry devkit's rule written out with 4x4 matrices and loops
+    (evaluate_odometry.cpp: trajectoryDistances, lastFrameFromSegmentLength,
+    calcSequenceErrors), as the independent reference."""
+    dist = [0.0]
+    for i in range(1, len(gt)):
+        dist.append(dist[-1] + np.linalg.norm(gt[i][:3, 3] - gt[i - 1][:3, 3]))
+    errors = []
+    for first in range(0, len(gt), step):
+        for L in lengths:
+            last = next((i for i in range(first, len(gt)) if dist[i] > dist[first] + L), -1)
+            if last == -1:
+                continue
+            d_gt = np.linalg.inv(gt[first]) @ gt[last]
+            d_est = np.linalg.inv(est[first]) @ est[last]
+            E = np.linalg.inv(d_est) @ d_gt
+            angle = np.arccos(np.clip(0.5 * (np.trace(E[:3, :3]) - 1.0), -1.0, 1.0))
+            errors.append((first, last, L, angle / L, np.linalg.norm(E[:3, 3]) / L))
+    return errors
+
+
+def test_kitti_errors_follow_the_devkit_rule():
+    rng = np.random.default_rng(11)
+    n = 400
+    # A car-like path: forward at ~1 m per frame, turning slowly; the estimate
+    # accumulates small random motion errors (drift).
+    steps = np.zeros((n, 6))
+    steps[:, 0] = 1.0 + 0.1 * np.sin(np.arange(n) / 30)
+    steps[:, 5] = 0.02 * np.sin(np.arange(n) / 50)
+    inc = rk.Transform.exp(steps)
+    noisy = inc @ rk.Transform.exp(
+        rng.normal(0, [0.01, 0.01, 0.01, 1e-3, 1e-3, 1e-3], (n, 6))
+    )
+    gt_pq, est_pq = [np.eye(4)], [np.eye(4)]
+    for k in range(n - 1):
+        gt_pq.append(gt_pq[-1] @ inc[k].as_matrix())
+        est_pq.append(est_pq[-1] @ noisy[k].as_matrix())
+    gt = rk.Trajectory(None, rk.Transform.from_matrix(np.array(gt_pq), orthonormalize=True))
+    est = rk.Trajectory(
+        None, rk.Transform.from_matrix(np.array(est_pq), orthonormalize=True)
+    )
+    lengths = (50, 100, 200, 300)
+    r = rk.trajectory.kitti_errors(gt, est, lengths=lengths, step=10)
+    ref = _devkit_reference(gt.poses.as_matrix(), est.poses.as_matrix(), lengths, 10)
+    assert len(ref) == len(r.first) > 40
+    np.testing.assert_array_equal(r.first, [e[0] for e in ref])
+    np.testing.assert_array_equal(r.last, [e[1] for e in ref])
+    np.testing.assert_array_equal(r.length, [e[2] for e in ref])
+    np.testing.assert_allclose(r.translation, [e[4] for e in ref], rtol=1e-9)
+    # The devkit's acos((tr R - 1) / 2) rounds to ~1e-8 rad at these ~1e-2 rad
+    # angles (acos' slope near 1); the reference's own rounding sets the bound.
+    np.testing.assert_allclose(r.rotation, [e[3] for e in ref], rtol=1e-6)
+    t_mean = np.mean([e[4] for e in ref])
+    assert r.translation_percent == pytest.approx(100 * t_mean, rel=1e-9)
+    r_mean = np.mean([e[3] for e in ref])
+    assert r.rotation_deg_per_100m == pytest.approx(np.degrees(r_mean) * 100, rel=1e-6)
+    for L in lengths:
+        sel = [e for e in ref if e[2] == L]
+        assert r.table[L][2] == len(sel)
+        assert r.table[L][0] == pytest.approx(100 * np.mean([e[4] for e in sel]), rel=1e-9)
+
+
+def test_kitti_errors_of_a_scaled_estimate():
+    x = np.arange(0.0, 1000.0, 0.5)
+    gt = rk.Trajectory(None, rk.Transform(translation=np.c_[x, 0 * x, 0 * x]))
+    est = gt.transform(rk.Similarity(scale=1.02))
+    r = rk.trajectory.kitti_errors(gt, est)
+    # Each segment spans the first 0.5 m step past L: 2 % of (L + 0.5) m per L.
+    for L, (t, rot, count) in r.table.items():
+        assert t == pytest.approx(2.0 * (L + 0.5) / L, rel=1e-12)
+        assert rot == 0.0
+        assert count == len(range(0, len(x), 10)) - sum(x[::10] + L >= x[-1])

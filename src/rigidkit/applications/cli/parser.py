@@ -7,6 +7,7 @@ import argparse
 from ... import __version__
 from .convert import PROG
 from .representations import is_number
+from .trajectories import add_trajectory_commands
 
 __all__ = ["build_parser", "shield_negative_numbers"]
 
@@ -149,6 +150,7 @@ def build_parser(run_convert) -> argparse.ArgumentParser:
         help="one rotation: an aligned table (default) or JSON",
     )
     convert.set_defaults(func=run_convert)
+    add_trajectory_commands(commands)
     return parser
 
 

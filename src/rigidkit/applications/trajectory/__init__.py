@@ -9,7 +9,23 @@ et al. 2012). Files are read and written by :mod:`rigidkit.io`.
 
 from .align import align
 from .associate import associate
+from .kitti import KittiResult, kitti_errors
 from .metrics import MetricResult, ape, rpe, statistics
+from .plot import plot, plot_error_colored, plot_errors, save_report
 from .trajectory import Trajectory
 
-__all__ = ["MetricResult", "Trajectory", "align", "ape", "associate", "rpe", "statistics"]
+__all__ = [
+    "KittiResult",
+    "MetricResult",
+    "Trajectory",
+    "align",
+    "ape",
+    "associate",
+    "kitti_errors",
+    "plot",
+    "plot_error_colored",
+    "plot_errors",
+    "rpe",
+    "save_report",
+    "statistics",
+]
