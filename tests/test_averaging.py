@@ -202,7 +202,7 @@ def test_compiled_chordal_path_matches_the_eigendecomposition(rng):
     if not averaging._gram_ready():
         if averaging._GRAM_JOB is None:
             pytest.skip("numba is not available")
-        averaging._GRAM_JOB.join()
+        averaging._GRAM_JOB.result()
     _, R = cluster(rng, (6, 500), 1.5)
     w = rng.uniform(0.0, 1.0, (6, 500))
     for dtype, tol in ((np.float64, 1e-13), (np.float32, 1e-5)):

@@ -22,7 +22,7 @@ def _ready_gram():
     if not averaging._gram_ready():
         if averaging._GRAM_JOB is None:
             pytest.skip("numba is not available")
-        averaging._GRAM_JOB.join()
+        averaging._GRAM_JOB.result()
 
 
 @pytest.mark.parametrize(

@@ -50,6 +50,14 @@ and K.BINDING is None:
 from __future__ import annotations
 
 import math
+import sys
+
+import numpy as np
+
+from . import numba_backend
+from .loop_source import SINGLE
+
+_INTS = (int, np.integer)
 
 
 def entry_point(loop):
@@ -64,6 +72,36 @@ def entry_point(loop):
         return loop.overloads[sig].entry_point
     except (AttributeError, KeyError, TypeError, ValueError):
         return loop
+
+
+def make_fast(kernel):
+    """Compile :func:`fast_source` of ``kernel``: ``fast(self, *args, out, backend)``.
+
+    Its namespace: NumPy's names, the kernel module (whose ``BINDING`` it reads at
+    each call), the kernel over Python floats, and ``E_*``, the kernel's tables
+    of ready entry points per broadcast pattern (filled as loops land).
+    """
+    env = {
+        "ndarray": np.ndarray,
+        "array": np.array,
+        "empty": np.empty,
+        "F64": np.dtype(np.float64),
+        "F32": np.dtype(np.float32),
+        "K": sys.modules[__package__ + ".kernel"],
+        "PMIN": numba_backend.PARALLEL_MIN,
+        "py": kernel.python,
+        "INTS": _INTS,
+    }
+    n = len(kernel.inputs)
+    for j in [None, *range(n)]:
+        if j is not None and n < 2:
+            continue
+        bcast = tuple(k == j for k in range(n))
+        env["E" + _tag(bcast)] = kernel._entry.setdefault(bcast, {})
+    env["E_single"] = kernel._entry.setdefault(SINGLE, {})
+    src = fast_source(kernel)
+    exec(compile(src, f"<rigidkit fast {kernel.name}>", "exec"), env)
+    return env["fast"]
 
 
 def _loop_key(params) -> str:
@@ -257,92 +295,3 @@ def _shape_n(shape) -> str:
 def _run_batch(outs, args) -> list[str]:
     """:func:`_run_loop` of the batch loop: outputs of shape ``(n, *trail)``."""
     return _run_loop(outs, args, _shape_n, status=True)
-
-
-def owned_source(kernel, names, result, indent=8, user=()) -> list[str]:
-    """Lines that run ``kernel`` on arrays an object owns, straight to its loops.
-
-    For the generated methods of objects (``a @ b``, ``a.inv()``) and functions
-    of them (``rk.slerp``): ``names`` are the variables holding the kernel's
-    input arrays (no static parameters). Each is known to have the kernel's
-    input shape after its batch axes (an object's stored array always has its
-    kind's trailing shape), except those also named in ``user``: arrays of the
-    caller's, of trailing shape ``()`` here (slerp's ``t``), whose number of
-    dimensions is tested here, its length and strides by the loop (status 1),
-    and its finiteness too (below). So of the fast entry's checks
-    only the exact ``ndarray`` type, the dtype and the batch shapes are left:
-    all inputs of one batch shape, one batch axis or none. When the loop ran,
-    ``result`` (lines that may read the output ``o0``) ends the method;
-    otherwise these lines fall through, and the method goes on to call the
-    kernel (its fast entry, or the general path). Runs in the namespace of
-    :func:`owned_env`. Saves the kernel call's own frame and its shape tests,
-    ~0.3 us of a 1 us ``a @ b`` at N = 10.
-
-    A ``user`` array's finiteness: in a batch the loop tests it, so only a
-    ``vector_math`` kernel may have one (its loop's status 2, see
-    :func:`.numba_backend._loop_source`); the one-element loop reports nothing,
-    so these lines test it (``isfinite``).
-    """
-    (out,) = kernel.outputs
-    ins = kernel.inputs
-    shared = [k for k, b in enumerate(names) if b not in user]
-    if kernel.params or any(ins[k] != ins[0] for k in shared) or shared[0] != 0:
-        raise ValueError(f"{kernel.name}: owned_source takes one object shape, no params")
-    if any(ins[k] != () for k, b in enumerate(names) if b in user) or (
-        user and not kernel.vector_math
-    ):
-        raise ValueError(
-            f"{kernel.name}: user arrays are of shape (), in vector_math kernels"
-        )
-    pad = " " * indent
-    rank = len(ins[0])
-    a = names[0]
-    batch_out = "(" + ", ".join(["s[0]", *map(str, out)]) + ("," if not out else "") + ")"
-    mine = [names[k] for k in shared]
-    theirs = [b for b in names if b in user]
-    # Chained tests (``type(a0) is ndarray is type(a1)``): each operand once, ~20%
-    # of these lines' cost at N = 10. A user array's length is its loop's to test
-    # (status 1), as its strides are.
-    types = " is ".join([f"type({a}) is ndarray"] + [f"type({b})" for b in names[1:]])
-    same = [" is ".join(["dt"] + [f"{b}.dtype" for b in names[1:]])] if names[1:] else []
-    same += [f"{b}.shape == s" for b in mine[1:]]
-    batch = "".join(f" and {b}.ndim == 1" for b in theirs)
-    single = "".join(f" and {b}.ndim == 0 and isfinite({b})" for b in theirs)
-    lines = [
-        f"if {types}:",
-        f"    dt = {a}.dtype",
-        f"    s = {a}.shape",
-        f"    if {' and '.join(same) or 'True'}:",
-        f"        if len(s) == {rank + 1}{batch}:",
-        "            loop = E_batch.get(dt)",
-        "            if loop is not None and s[0] < PMIN and K.BINDING is None:",
-        f"                o0 = empty({'s' if out == ins[0] else batch_out}, dt)",
-        f"                if not loop({', '.join(names)}, o0):",
-        *["                    " + x for x in result],
-        f"        elif len(s) == {rank}{single}:",
-        "            loop = E_single.get(dt)",
-        "            if loop is not None:",
-        f"                o0 = empty({tuple(out)!r}, dt)",
-        f"                loop({', '.join(names)}, o0)",
-        *["                " + x for x in result],
-    ]
-    return [pad + x for x in lines]
-
-
-def owned_env(kernel) -> dict:
-    """The names :func:`owned_source`'s lines read, for ``kernel``'s loops."""
-    import sys
-
-    import numpy as np
-
-    from . import numba_backend
-
-    return {
-        "ndarray": np.ndarray,
-        "empty": np.empty,
-        "isfinite": math.isfinite,
-        "PMIN": numba_backend.PARALLEL_MIN,
-        "K": sys.modules[__package__ + ".kernel"],  # its BINDING, read at each call
-        "E_batch": kernel._entry.setdefault((False,) * len(kernel.inputs), {}),
-        "E_single": kernel._entry.setdefault(numba_backend.SINGLE, {}),
-    }

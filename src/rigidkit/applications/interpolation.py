@@ -12,12 +12,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._engine.dispatch import owned_source
+from .._engine import owned_function
 from .._validate import finite_array, to_numpy
 from ..errors import DegenerateInputError, OutOfRangeError, ShapeError
 from ..functional import interpolation as _fi
 from ..kernels import geodesic as _kg
-from ..objects.group import compile_owned, new_object_lines
+from ..objects._batch import storage_slots
 from ..objects.rotation import Rotation
 from ..objects.transform import Transform
 
@@ -75,22 +75,21 @@ _quat_slerp = _fi.quat_slerp_unchecked
 def _owned_slerp(general):
     """``general`` made fast for its most frequent call: two NumPy ``Rotation``
     batches of one shape (one batch axis or none) and a float array ``t`` of their
-    dtype and batch shape, straight to the compiled loop of ``quat_slerp`` (see
-    :func:`.dispatch.owned_source`; the loop tests ``t``'s finiteness, ~0.5 us of a
-    ~2 us call at N = 10 in Python). Anything else calls ``general``, which
-    checks ``t`` itself and raises for a non-finite one with its batch index.
+    dtype and batch shape, straight to the compiled loop of ``quat_slerp`` (the
+    engine writes it: :func:`rigidkit._engine.owned_function`; the loop tests
+    ``t``'s finiteness, ~0.5 us of a ~2 us call at N = 10 in Python). Anything
+    else calls ``general``, which checks ``t`` itself and raises for a non-finite
+    one with its batch index.
     """
-    kernel = _kg.quat_slerp
-    result = new_object_lines(Rotation)
-    lines = [
-        "def slerp(a, b, t, *, decoupled=False):",
-        "    if type(a) is CLS is type(b) and not decoupled:",
-        "        a0 = a._quat",
-        "        a1 = b._quat",
-        *owned_source(kernel, ["a0", "a1", "t"], result, 8, user=("t",)),
-        "    return slow(a, b, t, decoupled=decoupled)",
-    ]
-    return compile_owned(lines, "slerp", kernel, Rotation, general, general.__qualname__)
+    return owned_function(
+        _kg.quat_slerp,
+        general,
+        Rotation,
+        ("a", "b"),
+        arrays=("t",),
+        off=("decoupled",),
+        slots=storage_slots(Rotation),
+    )
 
 
 slerp = _owned_slerp(slerp)

@@ -66,26 +66,22 @@ def common_calls(dtype) -> None:
 def main(argv=None) -> int:
     import numpy as np
 
-    from rigidkit._engine import kernel as kernel_module
-    from rigidkit._engine import numba_backend
+    from rigidkit._engine import cache_dir, numba_available, precompile, waiting_for_loops
 
     argv = sys.argv[1:] if argv is None else argv
     verbose = "-v" in argv
-    if not numba_backend.available():
+    if not numba_available():
         print("rigidkit: numba is not available; nothing to compile")
         return 0
     t0 = time.perf_counter()
-    count = numba_backend.precompile(shipped_kernels(), verbose=verbose)
-    kernel_module.NUMBA_MIN = 0  # every batch below waits for (compiles) its loop
-    try:
+    count = precompile(shipped_kernels(), verbose=verbose)
+    with waiting_for_loops():  # every batch below waits for (compiles) its loop
         for dtype in (np.float64, np.float32):
             common_calls(dtype)
-    finally:
-        kernel_module.NUMBA_MIN = None
     dt = time.perf_counter() - t0
     print(
         f"rigidkit: {count} kernel loops and the common variants compiled or loaded "
-        f"in {dt:.1f} s into {numba_backend._cache_dir()}"
+        f"in {dt:.1f} s into {cache_dir()}"
     )
     return 0
 

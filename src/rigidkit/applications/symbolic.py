@@ -74,7 +74,7 @@ from fractions import Fraction
 import sympy as sp
 
 from .. import kernels as _kernels_pkg
-from .._engine.kernel import Helper, Kernel, _rebind
+from .._engine import Helper, Kernel, rebind
 from .._engine.primitives import sympy_bindings
 
 #: Kernel modules whose names are top-level, first one first for shared names.
@@ -126,7 +126,7 @@ def _closed_helper(helper: Helper, env: dict):
     tuples of scalars) over dummy symbols, its branches chosen at a generic
     point, and the arguments substituted afterwards.
     """
-    raw = _rebind(helper.fn, env)
+    raw = rebind(helper.fn, env)
     cache: dict = {}
 
     def call(*args):
@@ -161,8 +161,8 @@ def _closed_function(kernel: Kernel):
     """
     env = dict(sympy_bindings())
     for dep in kernel.dependencies():
-        env[dep.name] = _closed_helper(dep, env) if dep.numerical else _rebind(dep.fn, env)
-    return _rebind(kernel.fn, env)
+        env[dep.name] = _closed_helper(dep, env) if dep.numerical else rebind(dep.fn, env)
+    return rebind(kernel.fn, env)
 
 
 def _flatten(args) -> list:

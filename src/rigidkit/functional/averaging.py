@@ -43,8 +43,7 @@ import warnings
 
 import numpy as np
 
-from .._engine import dask_backend
-from .._engine import numba_backend as _numba_backend
+from .._engine import compile_host_loop, dask_backend, in_background, numba_available
 from .._engine.namespace import device_of, namespace_of
 from .._validate import (
     _relabel,
@@ -130,14 +129,19 @@ def _weights(xp, weights, batch, axes, like):
 
 def _chordal(xp, q, w):
     """Dominant eigenvector of ``sum_k w_k q_k q_k^T``; q (kept, K, 4), w (kept, K)."""
-    if isinstance(q, np.ndarray) and q.shape[-2] >= GRAM_MIN and _gram_ready():
+    if (
+        isinstance(q, np.ndarray)
+        and q.dtype in _NO_WEIGHTS  # the dtypes it is compiled for
+        and q.shape[-2] >= GRAM_MIN
+        and _gram_ready()
+    ):
         return _chordal_compiled(q, w)
     m = q.mT @ (q if w is None else q * w[..., None])  # (kept, 4, 4)
     _, vecs = xp.linalg.eigh(m)
     return _kq.quat_canonical(vecs[..., :, -1])
 
 
-def _chordal_loop(q, w, weighted, out):  # pragma: no cover - compiled by numba
+def _chordal_loop(q, w, weighted, out):  # pragma: no cover - compiled by the engine
     """``out[g]``: dominant eigenvector of ``sum_k w[g, k] q[g, k] q[g, k]^T``.
 
     The 10 distinct sums in one pass over the quaternions, then cyclic Jacobi
@@ -258,28 +262,23 @@ _NO_WEIGHTS = {np.dtype(dt): np.empty((0, 0), dt) for dt in (np.float64, np.floa
 def _gram_ready() -> bool:
     """Whether the compiled Gram loop is ready; the first ask starts its compile.
 
-    The compile (or load from numba's cache) runs on a background thread, as the
-    engine's kernels do, so no call waits for it; until it is ready, BLAS serves.
+    The compile (or load from numba's cache) runs on the engine's background
+    thread, as the kernels' loops do, so no call waits for it; until it is ready,
+    BLAS serves.
     """
     global _GRAM_JOB
     if _GRAM is not None:
         return True
-    if _GRAM_JOB is None and _numba_backend.available():
-        import threading
-
-        _GRAM_JOB = threading.Thread(target=_compile_gram, daemon=True)
-        _GRAM_JOB.start()
+    if _GRAM_JOB is None and numba_available():
+        _GRAM_JOB = in_background("chordal mean", _compile_gram)
     return False
 
 
 def _compile_gram():
     global _GRAM
-    import numba
-
-    compiled = numba.njit(cache=True, nogil=True)(_chordal_loop)
-    for dt in (np.float64, np.float32):  # both signatures, off the caller's thread
-        compiled(np.ones((1, 1, 4), dt), np.zeros((0, 0), dt), False, np.zeros((1, 4), dt))
-    _GRAM = compiled
+    # q (groups, K, 4) and w (groups, K) read, weighted, out (groups, 4) written.
+    _GRAM = compile_host_loop(_chordal_loop, ("r3", "r2", "bool", "w2"))
+    return _GRAM
 
 
 def _chordal_compiled(q, w):

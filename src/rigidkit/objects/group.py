@@ -27,8 +27,9 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 
-from .._engine.dispatch import owned_env, owned_source
+from .._engine import owned_function
 from . import ladder
+from ._batch import storage_slots
 
 __all__ = ["Group", "LieGroup"]
 
@@ -230,53 +231,25 @@ def owned_method(cls, kernel, slow, other=None, *, array=False, out=False):
 
     For NumPy storage of one batch axis (or one element), and ``b`` of the same
     kind and shape, the method goes from the call straight to the kernel's
-    compiled loop (see :func:`.dispatch.owned_source`): these are the library's
-    most frequent calls, at N = 10 about 1 us in all, of which the method, the
-    kernel's entry and the new object are most. Anything else calls ``slow``,
-    the method written for the general case (whose docstring this one keeps).
+    compiled loop (the engine writes it: :func:`rigidkit._engine.owned_function`):
+    these are the library's most frequent calls, at N = 10 about 1 us in all, of
+    which the method, the kernel's entry and the new object are most. Anything
+    else calls ``slow``, the method written for the general case (whose
+    docstring this one keeps). A kernel that is not of this kind's stored arrays
+    alone leaves ``slow`` as it is.
 
     ``other``: the name of the second operand (``a @ b``), else None (``a.inv()``);
     ``array``: the method returns the kernel's array (``as_matrix``), not an
     object of ``cls``; ``out``: it takes ``out=`` (the fast path when it is None).
     """
-    kinds = [*kernel.inputs] + ([] if array else [*kernel.outputs])
-    if kernel.params or any(tuple(t) != tuple(cls._trail) for t in kinds):
-        return slow  # not a kernel of this kind's stored arrays alone
-    result = ["return o0"] if array else new_object_lines(cls)
-    names = ["a0"] if other is None else ["a0", "a1"]
-    args = ["self"] + ([other] if other else [])
-    head = f"def method({', '.join(args)}{', *, out=None' if out else ''}):"
-    fallback = f"    return slow({', '.join(args)}{', out=out' if out else ''})"
-    lines = [head]
-    if other:
-        lines += [f"    if type({other}) is not CLS:", "    " + fallback]
-    pad = "    "
-    if out:
-        lines.append("    if out is None:")
-        pad = "        "
-    lines.append(pad + "a0 = self._data")
-    if other:
-        lines.append(pad + f"a1 = {other}._data")
-    lines += owned_source(kernel, names, result, indent=len(pad))
-    lines.append(fallback)
-    qualname = f"{cls.__name__}.{slow.__name__}"
-    return compile_owned(lines, "method", kernel, cls, slow, qualname)
-
-
-def new_object_lines(cls) -> list[str]:
-    """Lines that return a new ``cls`` holding the loop's output ``o0`` (its
-    ``_wrap`` inlined: the array under ``_data`` and the class's own slot name)."""
-    storage = "_data" if cls._storage == "_data" else f"_data = r.{cls._storage}"
-    return ["r = new(CLS)", f"r.{storage} = o0", "return r"]
-
-
-def compile_owned(lines, name, kernel, cls, slow, qualname):
-    """The function ``name`` that ``lines`` define, in :func:`.dispatch.owned_env`'s
-    namespace plus ``CLS``, ``new`` and ``slow`` (the general function, whose
-    docstring, module and name it takes; ``__wrapped__`` points to it)."""
-    env = owned_env(kernel) | {"CLS": cls, "new": object.__new__, "slow": slow}
-    exec(compile("\n".join(lines) + "\n", f"<rigidkit {qualname} fast>", "exec"), env)
-    fn = env[name]
-    fn.__name__, fn.__qualname__, fn.__module__ = slow.__name__, qualname, slow.__module__
-    fn.__doc__, fn.__wrapped__ = slow.__doc__, slow
-    return fn
+    return owned_function(
+        kernel,
+        slow,
+        cls,
+        ("self", other) if other else ("self",),
+        off=("out",) if out else (),
+        result="array" if array else "object",
+        slots=storage_slots(cls),
+        element=cls._trail,
+        qualname=f"{cls.__name__}.{slow.__name__}",
+    )

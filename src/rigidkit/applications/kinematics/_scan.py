@@ -6,11 +6,12 @@
 :mod:`rigidkit.kernels.kinematics.planar`: associative, normalising). Two
 bindings of the same kernel:
 
-* NumPy with numba: one compiled loop over trajectories and steps, generated from
-  the kernel's own source (as the engine generates its loops), compiled for one
-  signature per dtype and cached on disk next to the engine's. Like the engine's
-  loops it is compiled (or loaded from the cache) by the engine's background
-  thread (:func:`.numba_backend.request_build`), never on the caller's: a call
+* NumPy with numba: one compiled loop over trajectories and steps, which the
+  engine generates from the kernel's own source (:func:`rigidkit._engine.compile_scan`),
+  compiled for one signature per dtype and cached on disk next to the kernels'
+  loops. Like those loops it is compiled (or loaded from the cache) by the
+  engine's background thread (:func:`rigidkit._engine.in_background`), never on
+  the caller's: a call
   made before it is ready runs the prefix product below, by chunks of
   ``CHUNK`` elements, and hands the rest to the scan if it lands meanwhile
   (3.6 M steps: 2.6 s for the first call of a fresh process with an empty cache,
@@ -35,9 +36,15 @@ import os
 
 import numpy as np
 
-from ..._engine import numba_backend as _nb
-from ..._engine.namespace import is_numpy, namespace_of
-from ..._engine.primitives import NUMBA_PRELUDE
+from ..._engine import (
+    compile_scan,
+    idle_workers,
+    in_background,
+    is_numpy,
+    namespace_of,
+    numba_available,
+    run_split,
+)
 
 #: Calls of fewer steps than this (over all trajectories) never ask for the
 #: compiled scan: the prefix product serves them in well under a millisecond more.
@@ -47,62 +54,19 @@ COMPILE_MIN = int(os.environ.get("RIGIDKIT_SCAN_COMPILE_MIN", "20000"))
 _SCANS: dict = {}
 
 
-def _scan_source(chain, width: int) -> str:
-    fns = [*chain.dependencies(), chain]
-    parts = [NUMBA_PRELUDE]
-    for f in fns:
-        parts.append(
-            "\n\n@numba.njit(inline='always', error_model='numpy')\n"
-            + _nb.function_source(f.fn)
-        )
-    w = range(width)
-    state = ", ".join(f"s{c}" for c in w)
-    lines = [
-        "def scan(body, x0, inc, out):",
-        "    n, steps = inc.shape[0], inc.shape[1]",
-        "    for b in range(n):",
-        *[f"        s{c} = x0[b, {c}]" for c in w],
-        *[f"        out[b, 0, {c}] = s{c}" for c in w],
-        "        for k in range(steps):",
-        f"            r = {chain.name}(body, {state}, "
-        + ", ".join(f"inc[b, k, {c}]" for c in w)
-        + ")",
-        *[f"            s{c} = r[{c}]" for c in w],
-        *[f"            out[b, k + 1, {c}] = s{c}" for c in w],
-    ]
-    parts.append("\n\n" + "\n".join(lines) + "\n")
-    return "\n".join(parts)
-
-
 def _build(chain, width: int, dtype):
     """Compile (or load from the disk cache) the scan of ``chain`` for ``dtype``.
 
-    Runs on the engine's background thread. One explicit signature (``body``
-    int64; ``x0`` (n, W) and ``inc`` (n, N, W) read-only; ``out`` (n, N + 1, W)),
-    so a call never compiles again.
+    Runs on the engine's background thread (:func:`rigidkit._engine.compile_scan`
+    generates and compiles it); the scan is served from ``_SCANS`` once there.
     """
-    import numba
-    from numba import types
-
-    module, cache = _nb.import_source(
-        f"rigidkit_scan_{chain.name}",
-        _scan_source(chain, width),
-        f"<rigidkit scan {chain.name}>",
-    )
-    dt = types.float32 if dtype.itemsize == 4 else types.float64
-    sig = types.void(
-        types.int64,
-        types.Array(dt, 2, "C", readonly=True),
-        types.Array(dt, 3, "C", readonly=True),
-        types.Array(dt, 3, "C"),
-    )
-    scan = numba.njit([sig], cache=cache, nogil=True, error_model="numpy")(module.scan)
+    scan = compile_scan(chain, dtype)
     _SCANS[(chain.name, width, dtype.char)] = scan
     return scan
 
 
 def _request(chain, width: int, dtype):
-    return _nb.request_build(
+    return in_background(
         ("scan", chain.name, width, dtype.char), lambda: _build(chain, width, dtype)
     )
 
@@ -112,7 +76,7 @@ def prepare(chain, x0, rate, steps: int) -> None:
 
     A no-op off NumPy, without numba, or below ``COMPILE_MIN`` steps in all.
     """
-    if not (isinstance(rate, np.ndarray) and _nb.available()):
+    if not (isinstance(rate, np.ndarray) and numba_available()):
         return
     batch = np.broadcast_shapes(tuple(x0.shape[:-1]), tuple(rate.shape[:-2]))
     if int(np.prod(batch, dtype=np.int64)) * steps < COMPILE_MIN:
@@ -128,10 +92,7 @@ def _width(chain) -> int:
 
 def wait(chain, dtype) -> None:
     """Block until the compiled scan of ``chain`` for ``dtype`` is ready (tests)."""
-    job = _request(chain, _width(chain), np.dtype(dtype))
-    job.done.wait()
-    if job.error is not None:
-        raise job.error
+    _request(chain, _width(chain), np.dtype(dtype)).result()
 
 
 def running_product(chain, body: int, x0, inc):
@@ -220,18 +181,11 @@ def _numba_product(scan, body, x0, inc, batch, n, steps, width, dtype):
         n, steps, width
     )
     out = np.empty((n, steps + 1, width), dtype)
-    workers = min(n, _nb._workers()) if n > 1 and n * steps >= 2 * COMPILE_MIN else 1
+    workers = min(n, idle_workers()) if n > 1 and n * steps >= 2 * COMPILE_MIN else 1
     if workers < 2:
         scan(body, x0, inc, out)
     else:
-        bounds = [n * k // workers for k in range(workers + 1)]
-        futures = [
-            _nb._pool().submit(scan, body, x0[a:b], inc[a:b], out[a:b])
-            for a, b in zip(bounds[1:-1], bounds[2:])
-        ]
-        scan(body, x0[: bounds[1]], inc[: bounds[1]], out[: bounds[1]])
-        for f in futures:
-            f.result()
+        run_split(scan, n, workers, lambda a, b: (body, x0[a:b], inc[a:b], out[a:b]))
     return out.reshape(batch + (steps + 1, width))
 
 
