@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import rigidkit as rk
+from conftest import GROUP_KINDS
 
 
 def _make(name, shape, rng):
@@ -22,16 +23,8 @@ def _values(x):
     return np.asarray(x) if isinstance(x, rk.Quaternion) else x.as_matrix()
 
 
-CLASSES = [
-    "Rotation",
-    "Transform",
-    "Rotation2D",
-    "Transform2D",
-    "Similarity",
-    "Affine",
-    "Projective",
-    "Quaternion",
-]
+# Every kind of the registry of groups (conftest.GROUP_KINDS), and Quaternion.
+CLASSES = [cls.__name__ for cls in GROUP_KINDS] + ["Quaternion"]
 
 
 @pytest.mark.parametrize("name", CLASSES)

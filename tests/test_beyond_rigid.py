@@ -745,14 +745,14 @@ def test_sim3_functional_layer(rng):
 
 # -- the ladder of kinds (rigidkit.objects.ladder) ---------------------------------------
 def test_ladder_ranks_and_families():
-    from rigidkit.objects import ladder
+    from rigidkit.objects import ladder, registry
 
     ranks = [ladder.kind_of(x)[1:] for x in _one_of_each(np.random.default_rng(1))]
     assert ranks == [("space", r) for r in range(5)]
     assert ladder.kind_of(rk.Transform2D.identity())[1:] == ("plane", 1)
     assert ladder.kind_of(np.eye(4)) is None
     with pytest.raises(ValueError, match="already has rank"):
-        ladder.register(type("Impostor", (), {}), "space", 2)
+        registry.register(type("Impostor", (), {}), "space", 2)
 
 
 def test_ladder_homogeneous_matrix_of_a_rotation(rng):

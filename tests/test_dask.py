@@ -119,7 +119,7 @@ def _geodesic_mean(q, w):
 
 def _jacobian(q):
     R = rk.Rotation.from_quat(q)
-    return rk.jacobians.compose(R, R, frame="left")[1]
+    return rk.jacobians.compose(R, R, side="left")[1]
 
 
 R_ = rk.Rotation.from_quat

@@ -1,10 +1,11 @@
 """The group axioms and Lie-group identities, once for every group class.
 
-Every entry of ``GROUPS`` is a class implementing :class:`rigidkit.objects.group.LieGroup`
-with its functional module (``hat``, ``vee``, ``bracket``); adding a group is one
-line. References are independent of the code under test: ``scipy.linalg.expm`` of
-the hat matrix, NumPy matrix products and inverses of ``as_matrix()``, the
-homogeneous action on points, and the Baker-Campbell-Hausdorff series.
+Every Lie group of the registry (:mod:`rigidkit.objects.registry`) is tested: a class
+implementing :class:`rigidkit.objects.group.LieGroup` with the functional module it
+declares (``hat``, ``vee``, ``bracket``); a new group needs no line here. References are
+independent of the code under test: ``scipy.linalg.expm`` of the hat matrix, NumPy
+matrix products and inverses of ``as_matrix()``, the homogeneous action on points, and
+the Baker-Campbell-Hausdorff series.
 
 Tangent vectors are sampled at the identity, near it (1e-8), uniformly (rotation
 angle below pi), near pi (pi - 1e-6) and exactly at pi, with the other tangent
@@ -13,7 +14,6 @@ components standard normal.
 
 from __future__ import annotations
 
-import importlib
 import math
 import pickle
 from dataclasses import dataclass
@@ -26,6 +26,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import rigidkit as rk
+from conftest import LIE_GROUPS
+from rigidkit.objects import registry
 
 EPS = np.finfo(np.float64).eps
 
@@ -49,28 +51,15 @@ class Group:
         return f
 
 
-def _group(cls_name, module_name, rot):
-    """A ``pytest.param`` for a group that may not be written yet (skipped if absent).
-
-    Tests that need the functional module skip when it is missing.
-    """
-    cls = getattr(rk, cls_name, None)
-    if cls is None:
-        return pytest.param(None, id=cls_name, marks=pytest.mark.skip(f"no rk.{cls_name}"))
-    try:
-        alg = importlib.import_module(f"rigidkit.functional.{module_name}")
-    except ImportError:
-        alg = None
-    return pytest.param(Group(cls, alg, rot), id=cls_name)
+def _group(cls):
+    """A ``pytest.param`` for a Lie group of the registry, with what it declares."""
+    spec = registry.spec(cls)
+    return pytest.param(Group(cls, spec.algebra, spec.part("rotation")), id=cls.__name__)
 
 
-GROUPS = [
-    _group("Rotation", "so3", slice(0, 3)),
-    _group("Transform", "se3", slice(3, 6)),
-    _group("Rotation2D", "so2", slice(0, 1)),
-    _group("Transform2D", "se2", slice(2, 3)),
-    _group("Similarity", "sim3", slice(3, 6)),  # twists (v, omega, log s)
-]
+# Discovered from the registry of groups (each class joins it when it is defined),
+# not listed: a new group is tested here as soon as its class exists.
+GROUPS = [_group(cls) for cls in LIE_GROUPS]
 
 KINDS = ["identity", "tiny", "uniform", "near_pi", "pi"]
 N = 48
@@ -477,3 +466,31 @@ def test_single_element_axioms(G, data):
     np.testing.assert_allclose(matrix(X @ X.inv()), eye(G), rtol=0, atol=tol)
     tol = 16 * EPS * big[0] * (1.0 + np.abs(a).max())
     np.testing.assert_allclose(matrix(G.cls.exp(X.log())), MX, rtol=0, atol=tol)
+
+
+def test_the_registry_is_the_list_of_groups():
+    """Every public transform class is registered (and so tested by every test that
+    iterates over the registry), each Lie group with its functional module and the
+    rotation part of its tangent; the ladder and ``rk.jacobians`` read the same
+    registry."""
+    from rigidkit.objects.group import Group as GroupBase
+    from rigidkit.objects.group import LieGroup
+
+    public = {
+        obj
+        for name in rk.__all__
+        if isinstance(obj := getattr(rk, name), type) and issubclass(obj, GroupBase)
+    }
+    assert public == set(registry.groups())
+    lie = {cls for cls in public if issubclass(cls, LieGroup)}
+    assert lie == set(LIE_GROUPS) == {G.values[0].cls for G in GROUPS}
+    for cls in lie:
+        spec = registry.spec(cls)
+        assert spec.cls is cls and spec.wrap == cls._wrap
+        assert spec.algebra.hat(np.zeros(cls.dof)).shape == (cls.matrix_size,) * 2
+        rot = spec.part("rotation")
+        assert 0 <= rot.start < rot.stop <= cls.dof
+        X = rk.jacobians.exp(cls, np.zeros(cls.dof))[0]
+        assert type(X) is cls
+    with pytest.raises(TypeError, match="Similarity"):
+        rk.jacobians.log(rk.Affine.identity())

@@ -1,15 +1,15 @@
 """``rk.jacobians``: the Jacobians of every group operation, against finite differences.
 
-One test for all five groups, the eight operations and both frames, at random points
-and near the identity (1e-8). The reference never uses the formulas under test: each
-operation is recomputed on the matrices of its operands (NumPy products and inverses,
-the matrix exponential and principal logarithm of this file, checked against
-``scipy.linalg.expm`` and ``logm``), each operand is perturbed on the manifold,
-``X expm(hat(h e_k))`` (right) or ``expm(hat(h e_k)) X`` (left), or by ``h e_k``
-for a point or a tangent, and the change of the value is read on the same
-side: ``vee(F_0^-1 (F_+ - F_-) / 2h)`` (right) or ``vee((F_+ - F_-) / 2h F_0^-1)``
-(left) for a group value, ``(F_+ - F_-) / 2h`` for a vector. ``vee`` is the
-least-squares coordinates on the generators ``hat(e_k)``.
+One test for every Lie group of the registry, the eight operations and both sides, at
+random points and near the identity (1e-8). The reference never uses the formulas under
+test: each operation is recomputed on the matrices of its operands (NumPy products and
+inverses, the matrix exponential and principal logarithm of this file, checked against
+``scipy.linalg.expm`` and ``logm``), each operand is perturbed on the manifold, ``X
+expm(hat(h e_k))`` (right) or ``expm(hat(h e_k)) X`` (left), or by ``h e_k`` for a point
+or a tangent, and the change of the value is read on the same side: ``vee(F_0^-1 (F_+ -
+F_-) / 2h)`` (right) or ``vee((F_+ - F_-) / 2h F_0^-1)`` (left) for a group value,
+``(F_+ - F_-) / 2h`` for a vector. ``vee`` is the least-squares coordinates on the
+generators ``hat(e_k)``.
 
 Tolerance: central differences with ``h = 1e-5`` err by ``h^2/6 |f'''|`` (truncation,
 ~2e-11 for third derivatives of order 1) plus ``eps |F_0^-1| |F| / h`` (rounding of
@@ -17,7 +17,7 @@ the reference ``expm``/``log``, a few ulp, over ``2h``: ~1e-11 times the size of
 entries, which grows with the scale ``e^sigma`` of Sim(3) and with translations).
 The largest error measured over five seeds is 1.6e-10 of ``1 + max |J|`` (Sim(3)
 ``minus``); ``FD_TOL = 1e-8`` leaves a margin of 60. A wrong formula is off by O(1):
-the Jacobian of the other frame differs from the finite differences by at least
+the Jacobian of the other side differs from the finite differences by at least
 0.05 of ``1 + max |J|`` at the random points (all groups but the abelian SO(2)).
 
 Sim(3)'s ``J_l`` (a series, :func:`rigidkit.sim3.left_jacobian`) is also checked
@@ -35,6 +35,8 @@ import pytest
 import scipy.linalg as sl
 
 import rigidkit as rk
+from conftest import LIE_GROUPS
+from rigidkit.objects import registry
 
 H = 1e-5
 FD_TOL = 1e-8
@@ -42,38 +44,34 @@ FD_TOL = 1e-8
 
 @dataclass(frozen=True)
 class Group:
-    cls_name: str
-    module: str
+    cls: type
+    alg: object  # the functional module (its hat)
     rot: slice  # the rotation components of the tangent
-    scale: int | None = None  # the log-scale component (Sim(3))
+    scale: slice | None = None  # the log-scale component (Sim(3))
 
     def __repr__(self):
-        return self.cls_name
-
-    @property
-    def cls(self):
-        return getattr(rk, self.cls_name)
+        return self.cls.__name__
 
     @property
     def dof(self):
         return self.cls.dof
 
     def hat(self, tau):
-        return np.asarray(getattr(rk, self.module).hat(np.asarray(tau)), dtype=np.float64)
+        return np.asarray(self.alg.hat(np.asarray(tau)), dtype=np.float64)
 
     def vee(self, M):
-        if self.cls_name not in _VEE:
+        if self.cls not in _VEE:
             # Least-squares coordinates on the generators hat(e_k), as one matrix.
             gens = np.stack([self.hat(e).ravel() for e in np.eye(self.dof)], axis=-1)
-            _VEE[self.cls_name] = np.linalg.pinv(gens)
-        return _VEE[self.cls_name] @ np.ravel(M)
+            _VEE[self.cls] = np.linalg.pinv(gens)
+        return _VEE[self.cls] @ np.ravel(M)
 
     def expm(self, tau):
         return matrix_exp(self.hat(tau))
 
     def step(self, k, sign):
         """``expm(hat(sign h e_k))`` (the same few matrices for every point)."""
-        key = (self.cls_name, k, sign)
+        key = (self.cls, k, sign)
         if key not in _STEPS:
             _STEPS[key] = self.expm(sign * H * np.eye(self.dof)[k])
         return _STEPS[key]
@@ -137,13 +135,13 @@ def principal_log(M):
     return (2.0 ** (k + 1)) * (Z @ S)
 
 
-GROUPS = [
-    Group("Rotation", "so3", slice(0, 3)),
-    Group("Transform", "se3", slice(3, 6)),  # (v, omega)
-    Group("Rotation2D", "so2", slice(0, 1)),
-    Group("Transform2D", "se2", slice(2, 3)),  # (vx, vy, theta)
-    Group("Similarity", "sim3", slice(3, 6), 6),  # (v, omega, log s)
-]
+def _group(cls):
+    spec = registry.spec(cls)
+    return Group(cls, spec.algebra, spec.part("rotation"), spec.part("scale"))
+
+
+# Every Lie group of the registry (:mod:`rigidkit.objects.registry`), not a list.
+GROUPS = [_group(cls) for cls in LIE_GROUPS]
 
 
 def tangent(G, where, rng, max_angle=2.5):
@@ -169,21 +167,21 @@ def _apply(M, p):
 
 
 OPS = {
-    "compose": ("gg", lambda G, X, Y, f: rk.jacobians.compose(X, Y, frame=f),
+    "compose": ("gg", lambda G, X, Y, f: rk.jacobians.compose(X, Y, side=f),
                 lambda G, A, B: A @ B, "g"),
-    "inv": ("g", lambda G, X, f: rk.jacobians.inv(X, frame=f),
+    "inv": ("g", lambda G, X, f: rk.jacobians.inv(X, side=f),
             lambda G, A: np.linalg.inv(A), "g"),
-    "apply": ("gp", lambda G, X, p, f: rk.jacobians.apply(X, p, frame=f),
+    "apply": ("gp", lambda G, X, p, f: rk.jacobians.apply(X, p, side=f),
               lambda G, A, p: _apply(A, p), "p"),
-    "log": ("g", lambda G, X, f: rk.jacobians.log(X, frame=f),
+    "log": ("g", lambda G, X, f: rk.jacobians.log(X, side=f),
             lambda G, A: G.logm(A), "t"),
-    "exp": ("t", lambda G, tau, f: rk.jacobians.exp(G.cls, tau, frame=f),
+    "exp": ("t", lambda G, tau, f: rk.jacobians.exp(G.cls, tau, side=f),
             lambda G, tau: G.expm(tau), "g"),
-    "plus": ("gt", lambda G, X, tau, f: rk.jacobians.plus(X, tau, frame=f),
+    "plus": ("gt", lambda G, X, tau, f: rk.jacobians.plus(X, tau, side=f),
              lambda G, A, tau: A @ G.expm(tau), "g"),
-    "minus": ("gg", lambda G, X, Y, f: rk.jacobians.minus(X, Y, frame=f),
+    "minus": ("gg", lambda G, X, Y, f: rk.jacobians.minus(X, Y, side=f),
               lambda G, A, B: G.logm(np.linalg.inv(B) @ A), "t"),
-    "between": ("gg", lambda G, X, Y, f: rk.jacobians.between(X, Y, frame=f),
+    "between": ("gg", lambda G, X, Y, f: rk.jacobians.between(X, Y, side=f),
                 lambda G, A, B: np.linalg.inv(A) @ B, "g"),
 }  # fmt: skip
 
@@ -211,7 +209,7 @@ def operands(G, op, where, rng, n=2):
     return cols
 
 
-def fd_jacobians(G, op, refs, frame):
+def fd_jacobians(G, op, refs, side):
     """Finite-difference Jacobians of ``op`` at one set of operands ``refs``."""
     kinds, _, ref, out_kind = OPS[op]
     F0 = ref(G, *refs)
@@ -226,37 +224,37 @@ def fd_jacobians(G, op, refs, frame):
                 args = list(refs)
                 if kind == "g":
                     step = G.step(int(np.argmax(e)), sign)
-                    args[i] = args[i] @ step if frame == "right" else step @ args[i]
+                    args[i] = args[i] @ step if side == "right" else step @ args[i]
                 else:
                     args[i] = args[i] + sign * H * e
                 F.append(ref(G, *args))
             dF = (F[0] - F[1]) / (2 * H)
             if out_kind == "g":
-                dF = G.vee(F0_inv @ dF if frame == "right" else dF @ F0_inv)
+                dF = G.vee(F0_inv @ dF if side == "right" else dF @ F0_inv)
             cols.append(dF)
         jacobians.append(np.stack(cols, axis=-1))
     return F0, jacobians
 
 
 @pytest.mark.parametrize("where", ["random", "identity"])
-@pytest.mark.parametrize("frame", ["right", "left"])
+@pytest.mark.parametrize("side", ["right", "left"])
 @pytest.mark.parametrize("op", list(OPS))
 @pytest.mark.parametrize("G", GROUPS, ids=repr)
-def test_jacobians_by_finite_differences_on_the_manifold(G, op, frame, where, rng):
+def test_jacobians_by_finite_differences_on_the_manifold(G, op, side, where, rng):
     kinds, call, ref, out_kind = OPS[op]
     cols = operands(G, op, where, rng)
-    value, *J = call(G, *[c[0] for c in cols], frame)
+    value, *J = call(G, *[c[0] for c in cols], side)
     assert len(J) == len(kinds)
     for b in range(2):
         refs = [c[1][b] for c in cols]
-        F0, J_fd = fd_jacobians(G, op, refs, frame)
+        F0, J_fd = fd_jacobians(G, op, refs, side)
         got = np.asarray(value.as_matrix() if out_kind == "g" else value)[b]
         np.testing.assert_allclose(got, F0, rtol=0, atol=1e-12 * (1 + np.abs(F0).max()))
         for k, (J_rk, J_ref) in enumerate(zip(J, J_fd, strict=True)):
             J_rk = np.asarray(J_rk)[b]
             assert J_rk.shape == J_ref.shape
             err = np.abs(J_rk - J_ref).max()
-            assert err <= FD_TOL * (1 + np.abs(J_ref).max()), (op, frame, k, err)
+            assert err <= FD_TOL * (1 + np.abs(J_ref).max()), (op, side, k, err)
 
 
 def test_reference_exp_and_log_against_scipy(rng):
@@ -324,26 +322,26 @@ def test_batch_shapes_and_float32(G, rng):
         for Jk, trail in zip(J, trails, strict=True):
             assert np.asarray(Jk).shape == (2, 3) + trail, name
     assert np.asarray(rk.jacobians.inv(X)[1]).shape == (2, 1, dof, dof)
-    assert np.asarray(rk.jacobians.log(Y, frame="left")[1]).shape == (3, dof, dof)
+    assert np.asarray(rk.jacobians.log(Y, side="left")[1]).shape == (3, dof, dof)
     assert np.asarray(rk.jacobians.exp(G.cls, tau)[1]).shape == (3, dof, dof)
     # float32: every Jacobian float32, within float32 rounding of the float64 ones.
     t32 = tau.astype(np.float32)
     X32, Y32 = G.cls.exp(t32), G.cls.exp(t32[::-1].copy())
     X64, Y64 = G.cls.exp(tau), G.cls.exp(tau[::-1].copy())
-    for frame in ("right", "left"):
-        got = rk.jacobians.minus(X32, Y32, frame=frame)[1:]
-        want = rk.jacobians.minus(X64, Y64, frame=frame)[1:]
+    for side in ("right", "left"):
+        got = rk.jacobians.minus(X32, Y32, side=side)[1:]
+        want = rk.jacobians.minus(X64, Y64, side=side)[1:]
         for a, b in zip(got, want, strict=True):
             assert a.dtype == np.float32
             np.testing.assert_allclose(a, b, rtol=0, atol=1e-4 * (1 + np.abs(b).max()))
-        _, J_X, J_p = rk.jacobians.apply(X32, p[0].astype(np.float32), frame=frame)
+        _, J_X, J_p = rk.jacobians.apply(X32, p[0].astype(np.float32), side=side)
         assert J_X.dtype == J_p.dtype == np.float32
 
 
 def test_bad_arguments():
     R = rk.Rotation.identity()
-    with pytest.raises(ValueError, match="frame must be 'right' or 'left'"):
-        rk.jacobians.compose(R, R, frame="body")
+    with pytest.raises(ValueError, match="side must be 'right' or 'left'"):
+        rk.jacobians.compose(R, R, side="body")
     with pytest.raises(TypeError, match="one group"):
         rk.jacobians.minus(R, rk.Transform.identity())
     with pytest.raises(TypeError, match="must be one of"):
@@ -358,11 +356,11 @@ def test_jax_jit(jax, jnp, rng):
 
     @jax.jit
     def f(X, Y):
-        return rk.jacobians.compose(X, Y, frame="left")
+        return rk.jacobians.compose(X, Y, side="left")
 
     got = f(rk.Rotation.exp(jnp.asarray(tau_x)), rk.Rotation.exp(jnp.asarray(tau_y)))
     got = (got[0].as_matrix(), *got[1:])
-    want = rk.jacobians.compose(X, Y, frame="left")
+    want = rk.jacobians.compose(X, Y, side="left")
     want = (want[0].as_matrix(), *want[1:])
     for a, b in zip(got, want, strict=True):
         np.testing.assert_allclose(np.asarray(a), b, rtol=0, atol=1e-12)
@@ -372,9 +370,9 @@ def test_torch_gradients_flow(torch, rng):
     """torch in, torch out, equal to NumPy; the Jacobians are differentiable."""
     tau = rng.standard_normal((3, 6)) * 0.5
     p = rng.standard_normal((3, 3))
-    want = rk.jacobians.apply(rk.Transform.exp(tau), p, frame="left")
+    want = rk.jacobians.apply(rk.Transform.exp(tau), p, side="left")
     t = torch.tensor(tau, requires_grad=True)
-    got = rk.jacobians.apply(rk.Transform.exp(t), torch.tensor(p), frame="left")
+    got = rk.jacobians.apply(rk.Transform.exp(t), torch.tensor(p), side="left")
     for a, b in zip(got, want, strict=True):
         assert isinstance(a, torch.Tensor) and a.dtype == torch.float64
         np.testing.assert_allclose(a.detach().numpy(), b, rtol=0, atol=1e-13)

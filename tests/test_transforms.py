@@ -133,7 +133,7 @@ OPS = [
     ),
     (
         "jacobians.compose(left): Ad(X)",
-        lambda q, p: rk.jacobians.compose(R_(q), R_(p), frame="left")[-1],
+        lambda q, p: rk.jacobians.compose(R_(q), R_(p), side="left")[-1],
         "q q2",
         True,
     ),

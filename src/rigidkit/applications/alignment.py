@@ -12,6 +12,7 @@ give ``...`` problems at once. The algorithms are in
 from __future__ import annotations
 
 from ..functional import alignment as _fa
+from ..objects.registry import spec
 from ..objects.rotation import Rotation
 from ..objects.transform import Transform
 
@@ -60,7 +61,7 @@ def align_vectors(a, b, weights=None):
     (True, True)
     """
     quat, rssd = _fa.kabsch(a, b, weights)
-    return Rotation._wrap(quat), rssd
+    return spec(Rotation).wrap(quat), rssd
 
 
 def align_points(src, dst, weights=None, *, scale=False):
@@ -105,5 +106,5 @@ def align_points(src, dst, weights=None, *, scale=False):
     if scale:
         from ..objects.similarity import Similarity
 
-        return Similarity._wrap(pose)
-    return Transform._wrap(pose)
+        return spec(Similarity).wrap(pose)
+    return spec(Transform).wrap(pose)

@@ -17,7 +17,9 @@ from .._validate import finite_array, to_numpy
 from ..errors import DegenerateInputError, OutOfRangeError, ShapeError
 from ..functional import interpolation as _fi
 from ..kernels import geodesic as _kg
+from ..objects import registry
 from ..objects._batch import storage_slots
+from ..objects.registry import stored
 from ..objects.rotation import Rotation
 from ..objects.transform import Transform
 
@@ -52,15 +54,16 @@ def slerp(a, b, t, *, decoupled=False):
     array([0.        , 0.78539816, 1.57079633])
     """
     if type(a) is Rotation and type(b) is Rotation and not decoupled:  # the common call
-        return _wrap_rotation(_quat_slerp(a._quat, b._quat, t))
+        # ``_data``: the stored array (``registry.stored``), read without a call here
+        return _wrap_rotation(_quat_slerp(a._data, b._data, t))
     if isinstance(a, Transform) and isinstance(b, Transform):
-        return Transform._wrap(
-            _fi.pose_slerp_unchecked(a._pose, b._pose, t, decoupled=decoupled)
+        return _wrap_transform(
+            _fi.pose_slerp_unchecked(stored(a), stored(b), t, decoupled=decoupled)
         )
     if isinstance(a, Rotation) and isinstance(b, Rotation):
         if decoupled:
             raise TypeError("decoupled= applies to Transform, not Rotation")
-        return Rotation._wrap(_fi.quat_slerp_unchecked(a._quat, b._quat, t))
+        return _wrap_rotation(_fi.quat_slerp_unchecked(stored(a), stored(b), t))
     raise TypeError(
         "slerp interpolates two Rotations or two Transforms, got "
         f"{type(a).__name__} and {type(b).__name__}"
@@ -68,7 +71,8 @@ def slerp(a, b, t, *, decoupled=False):
 
 
 # Bound once: each global and attribute lookup is ~30 ns of a ~1 us call.
-_wrap_rotation = Rotation._wrap
+_wrap_rotation = registry.spec(Rotation).wrap
+_wrap_transform = registry.spec(Transform).wrap
 _quat_slerp = _fi.quat_slerp_unchecked
 
 
@@ -184,8 +188,8 @@ class Slerp:
         flat = q.reshape(-1)
         idx = _fi.segment_index(self.times, flat)
         alpha = (flat - self.times[idx]) / self._dt[idx]
-        data = self.keyframes._data
-        extra = data.ndim - 1 - len(self.keyframes._trail)
+        data = stored(self.keyframes)
+        extra = len(self.keyframes.shape) - 1
         alpha = alpha.reshape(alpha.shape + (1,) * extra)
         x0 = _take(data, idx)
         x1 = _take(data, idx + 1)
@@ -194,8 +198,8 @@ class Slerp:
             out = _fi.pose_slerp_unchecked(x0, x1, alpha, decoupled=self.decoupled)
         else:
             out = _fi.quat_slerp_unchecked(x0, x1, alpha)
-        kind = type(self.keyframes)
-        return kind._wrap(out.reshape(q.shape + tuple(out.shape[1:])))
+        wrap = registry.spec(type(self.keyframes)).wrap
+        return wrap(out.reshape(q.shape + tuple(out.shape[1:])))
 
 
 def _take(data, idx):

@@ -1,18 +1,20 @@
 """Jacobians of every group operation: ``rk.jacobians``.
 
-For ``Rotation`` (SO(3)), ``Transform`` (SE(3)), ``Rotation2D`` (SO(2)),
-``Transform2D`` (SE(2)) and ``Similarity`` (Sim(3)): each function returns the value
+For every Lie group of the registry (:mod:`rigidkit.objects.registry`):
+``Rotation`` (SO(3)), ``Transform`` (SE(3)), ``Rotation2D`` (SO(2)),
+``Transform2D`` (SE(2)) and ``Similarity`` (Sim(3)). Each function returns the value
 of the operation and its Jacobians with respect to each operand, ``(value, J_1,
 ...)``, batched over leading axes like the operation itself (every Jacobian is
 broadcast to the value's batch shape).
 
-Design: a module of functions, ``rk.jacobians.compose(X, Y, frame="right")``,
+Design: a module of functions, ``rk.jacobians.compose(X, Y, side="right")``,
 rather than a ``jacobians=True`` keyword on the methods. An option never changes
-a return type (STYLE.md), the objects stay thin (no Jacobian code in five
-classes), and the formulas live once, here, for every group, built from what each
-group already has: ``adjoint()``, ``inv()``, ``as_matrix()``, and its functional
-module's ``hat`` and ``right_jacobian`` / ``right_jacobian_inverse`` /
-``left_jacobian_inverse`` (:mod:`rigidkit.functional._lie`). The two array-level
+a return type, the objects stay thin (no Jacobian code in any class), and the
+formulas live once, here, for every group, built from what each group already
+has: ``adjoint()``, ``inv()``, ``as_matrix()``, and the ``hat`` and
+``right_jacobian`` / ``right_jacobian_inverse`` / ``left_jacobian_inverse`` of the
+functional module it declares (its ``GroupSpec.algebra``,
+:mod:`rigidkit.objects.registry`). The two array-level
 formulas shared by all groups (the action's generator and the left-from-right
 conversion) are in :mod:`rigidkit.functional.jacobians`.
 
@@ -20,12 +22,13 @@ Conventions (those of manif, Solà et al. 2018, "A micro Lie theory"): tangents
 are those of the group (``(v, omega)`` for SE(3), ``(v, omega, sigma)`` for
 Sim(3), ``(vx, vy, theta)`` for SE(2)); ``X ⊕ tau = X exp(tau)`` and ``X ⊖ Y =
 log(Y^-1 X)`` (the right plus and minus, the default ``side`` of
-:meth:`~rigidkit.objects.group.LieGroup.plus`). The frame of a Jacobian says on
-which side the perturbation acts, on inputs and output alike:
+:meth:`~rigidkit.objects.group.LieGroup.plus`). The ``side`` of a Jacobian says
+on which side the perturbation acts, on inputs and output alike (the keyword of
+``plus`` and ``minus``; ``frame=`` names world and body velocities elsewhere):
 
-- ``frame="right"`` (local, body): ``f(X exp(d)) ~ f(X) exp(J^R d)``, i.e.
+- ``side="right"`` (local, body): ``f(X exp(d)) ~ f(X) exp(J^R d)``, i.e.
   ``J^R = d log(f(X)^-1 f(X exp(d))) / dd`` at ``d = 0``;
-- ``frame="left"`` (global, world): ``f(exp(d) X) ~ exp(J^L d) f(X)``;
+- ``side="left"`` (global, world): ``f(exp(d) X) ~ exp(J^L d) f(X)``;
 
 for an operand or a value in a vector space (a point, a tangent) the perturbation
 is plain addition. The two are related by ``J^L = Ad(f(X)) J^R Ad(X)^-1``
@@ -77,50 +80,35 @@ import numpy as np
 from .._engine.namespace import device_of, namespace_of
 from .._validate import as_array, as_float
 from ..functional import jacobians as _fj
-from ..functional import se2 as _se2
-from ..functional import se3 as _se3
-from ..functional import sim3 as _sim3
-from ..functional import so2 as _so2
-from ..functional import so3 as _so3
-from ..objects.rotation import Rotation
-from ..objects.rotation2d import Rotation2D
-from ..objects.similarity import Similarity
-from ..objects.transform import Transform
-from ..objects.transform2d import Transform2D
+from ..objects import registry
 
 __all__ = ["compose", "inv", "apply", "log", "exp", "plus", "minus", "between"]
 
-# Each group and its functional module (hat and the Jacobians of its tangent).
-_ALGEBRA = {
-    Rotation: _so3,
-    Transform: _se3,
-    Rotation2D: _so2,
-    Transform2D: _se2,
-    Similarity: _sim3,
-}
-
 
 def _algebra(cls, what):
-    alg = _ALGEBRA.get(cls)
-    if alg is None:
-        names = ", ".join(c.__name__ for c in _ALGEBRA)
+    """The functional module of the Lie group ``cls`` (hat and the Jacobians of its
+    tangent), as the group declares it (:mod:`rigidkit.objects.registry`)."""
+    spec = registry.spec(cls)
+    if spec is None or spec.algebra is None:
+        names = ", ".join(c.__name__ for c in registry.groups(lie=True))
         raise TypeError(f"{what} must be one of {names}, got {cls.__name__}")
-    return alg
+    return spec.algebra
 
 
-def _check_frame(frame):
-    if frame not in ("right", "left"):
-        raise ValueError(f"frame must be 'right' or 'left', got {frame!r}")
-    return frame == "left"
+def _check_side(side):
+    if side not in ("right", "left"):
+        raise ValueError(f"side must be 'right' or 'left', got {side!r}")
+    return side == "left"
 
 
 def _same_kind(X, Y, fn):
-    _algebra(type(X), f"the first operand of jacobians.{fn}")
+    alg = _algebra(type(X), f"the first operand of jacobians.{fn}")
     if type(Y) is not type(X):
         raise TypeError(
             f"jacobians.{fn} takes two elements of one group, got {type(X).__name__} "
             f"and {type(Y).__name__} (convert with {type(X).__name__}.include)"
         )
+    return alg
 
 
 def _ad_inv(X):
@@ -137,16 +125,16 @@ def _out(batch, *jacobians):
     return tuple(xp.broadcast_to(J, tuple(batch) + tuple(J.shape[-2:])) for J in jacobians)
 
 
-def compose(X, Y, *, frame="right"):
+def compose(X, Y, *, side="right"):
     """``Z = X @ Y`` (``Y`` applied first) and ``dZ/dX``, ``dZ/dY``.
 
-    Right: ``(Ad(Y)^-1, I)``; left: ``(I, Ad(X))`` (module docs for the frames).
+    Right: ``(Ad(Y)^-1, I)``; left: ``(I, Ad(X))`` (module docs for the sides).
 
     Parameters
     ----------
     X, Y : LieGroup
         Elements of one group; batch shapes broadcast.
-    frame : {"right", "left"}
+    side : {"right", "left"}
         ``"right"`` (local): ``f(X exp(d)) ~ f(X) exp(J d)``; ``"left"`` (global):
         ``f(exp(d) X) ~ exp(J d) f(X)``.
 
@@ -170,7 +158,7 @@ def compose(X, Y, *, frame="right"):
     (True, True)
     """
     _same_kind(X, Y, "compose")
-    left = _check_frame(frame)
+    left = _check_side(side)
     Z = X.compose(Y)  # not @: TorchDynamo cannot trace it on objects
     J_X = _ad_inv(Y)
     J_Y = _eye(J_X, X.dof)
@@ -180,13 +168,13 @@ def compose(X, Y, *, frame="right"):
     return (Z, *_out(Z.shape, J_X, J_Y))
 
 
-def inv(X, *, frame="right"):
+def inv(X, *, side="right"):
     """``X^-1`` and its Jacobian: ``-Ad(X)`` (right), ``-Ad(X)^-1`` (left).
 
     Parameters
     ----------
     X : LieGroup
-    frame : {"right", "left"}
+    side : {"right", "left"}
         As in :func:`compose`.
 
     Returns
@@ -204,7 +192,7 @@ def inv(X, *, frame="right"):
     True
     """
     _algebra(type(X), "jacobians.inv's operand")
-    left = _check_frame(frame)
+    left = _check_side(side)
     X_inv = X.inv()
     J = -X.adjoint()
     if left:
@@ -212,21 +200,21 @@ def inv(X, *, frame="right"):
     return X_inv, J
 
 
-def apply(X, points, *, frame="right"):
+def apply(X, points, *, side="right"):
     """``p' = X @ p`` (the action on points) and ``dp'/dX``, ``dp'/dp``.
 
     With ``L`` the linear block of ``X``'s matrix (``R``, or ``s R`` for Sim(3))
     and ``G(p)`` the velocity of ``p`` under a tangent (``hat(tau) [p; 1] = G(p)
     tau``; ``[I, -hat(p)]`` for SE(3)): right ``(L G(p), L)``, left ``(G(X p),
-    L)``. ``p`` lives in a vector space, so ``dp'/dp`` is the same in both frames.
+    L)``. ``p`` lives in a vector space, so ``dp'/dp`` is the same on both sides.
 
     Parameters
     ----------
     X : LieGroup
     points : array_like, shape (..., d)
         ``d = X.point_dim``; batch shapes broadcast with ``X``'s.
-    frame : {"right", "left"}
-        Frame of the perturbation of ``X`` (as in :func:`compose`).
+    side : {"right", "left"}
+        Side of the perturbation of ``X`` (as in :func:`compose`).
 
     Returns
     -------
@@ -248,7 +236,7 @@ def apply(X, points, *, frame="right"):
            [ 0.,  0.,  0.]])
     """
     alg = _algebra(type(X), "jacobians.apply's operand")
-    left = _check_frame(frame)
+    left = _check_side(side)
     d = X.point_dim
     p = as_float(as_array(points, (d,), "points"))
     y = X.apply(p)
@@ -259,14 +247,14 @@ def apply(X, points, *, frame="right"):
     return (y, *_out(y.shape[:-1], J_X, L))
 
 
-def log(X, *, frame="right"):
+def log(X, *, side="right"):
     """``tau = log(X)`` and its Jacobian: ``J_r^-1(tau)`` (right), ``J_l^-1(tau)`` (left).
 
     Parameters
     ----------
     X : LieGroup
-    frame : {"right", "left"}
-        Frame of the perturbation of ``X`` (the tangent is a vector space).
+    side : {"right", "left"}
+        Side of the perturbation of ``X`` (the tangent is a vector space).
 
     Returns
     -------
@@ -287,7 +275,7 @@ def log(X, *, frame="right"):
     True
     """
     alg = _algebra(type(X), "jacobians.log's operand")
-    left = _check_frame(frame)
+    left = _check_side(side)
     tau = X.log()
     J = alg.right_jacobian_inverse(tau)
     if left:
@@ -295,7 +283,7 @@ def log(X, *, frame="right"):
     return tau, J
 
 
-def exp(cls, tau, *, frame="right"):
+def exp(cls, tau, *, side="right"):
     """``X = cls.exp(tau)`` and its Jacobian: ``J_r(tau)`` (right), ``J_l(tau)`` (left).
 
     Parameters
@@ -305,8 +293,8 @@ def exp(cls, tau, *, frame="right"):
         ``rk.Transform2D`` or ``rk.Similarity``.
     tau : array_like, shape (..., dof)
         Tangent vectors in the group's order.
-    frame : {"right", "left"}
-        Frame of the value's perturbation (the tangent is a vector space).
+    side : {"right", "left"}
+        Side of the value's perturbation (the tangent is a vector space).
 
     Returns
     -------
@@ -326,7 +314,7 @@ def exp(cls, tau, *, frame="right"):
     array([[1.]])
     """
     alg = _algebra(cls, "jacobians.exp's group")
-    left = _check_frame(frame)
+    left = _check_side(side)
     X = cls.exp(tau)
     J = alg.right_jacobian(tau)
     if left:
@@ -334,7 +322,7 @@ def exp(cls, tau, *, frame="right"):
     return X, J
 
 
-def plus(X, tau, *, frame="right"):
+def plus(X, tau, *, side="right"):
     """``Y = X ⊕ tau = X @ exp(tau)`` and ``dY/dX``, ``dY/dtau``.
 
     Right: ``(Ad(exp tau)^-1, J_r(tau))``; left: ``(I, Ad(X) J_l(tau))``.
@@ -344,7 +332,7 @@ def plus(X, tau, *, frame="right"):
     X : LieGroup
     tau : array_like, shape (..., dof)
         Batch shapes broadcast with ``X``'s.
-    frame : {"right", "left"}
+    side : {"right", "left"}
         As in :func:`compose` (``tau`` is a vector space).
 
     Returns
@@ -366,7 +354,7 @@ def plus(X, tau, *, frame="right"):
     (True, True)
     """
     alg = _algebra(type(X), "jacobians.plus's operand")
-    left = _check_frame(frame)
+    left = _check_side(side)
     D = type(X).exp(tau)
     Y = X.compose(D)
     J_X = _ad_inv(D)
@@ -377,7 +365,7 @@ def plus(X, tau, *, frame="right"):
     return (Y, *_out(Y.shape, J_X, J_tau))
 
 
-def minus(X, Y, *, frame="right"):
+def minus(X, Y, *, side="right"):
     """``tau = X ⊖ Y = log(Y^-1 @ X)`` and ``dtau/dX``, ``dtau/dY``.
 
     Right: ``(J_r^-1(tau), -J_l^-1(tau))``; left: each times ``Ad`` of the
@@ -387,7 +375,7 @@ def minus(X, Y, *, frame="right"):
     ----------
     X, Y : LieGroup
         Elements of one group; batch shapes broadcast.
-    frame : {"right", "left"}
+    side : {"right", "left"}
         As in :func:`compose` (the value is a tangent vector).
 
     Returns
@@ -408,9 +396,8 @@ def minus(X, Y, *, frame="right"):
     >>> bool(np.allclose(tau, [0.0, 0.0, 0.4])), bool(np.allclose(J_Y, -J_X.T))
     (True, True)
     """
-    _same_kind(X, Y, "minus")
-    alg = _ALGEBRA[type(X)]
-    left = _check_frame(frame)
+    alg = _same_kind(X, Y, "minus")
+    left = _check_side(side)
     tau = Y.inv().compose(X).log()
     J_X = alg.right_jacobian_inverse(tau)
     J_Y = -alg.left_jacobian_inverse(tau)
@@ -419,7 +406,7 @@ def minus(X, Y, *, frame="right"):
     return (tau, *_out(tau.shape[:-1], J_X, J_Y))
 
 
-def between(X, Y, *, frame="right"):
+def between(X, Y, *, side="right"):
     """``Z = X^-1 @ Y`` (``Y`` seen from ``X``: ``B_T_C = A_T_B^-1 A_T_C``) and
     ``dZ/dX``, ``dZ/dY``.
 
@@ -429,7 +416,7 @@ def between(X, Y, *, frame="right"):
     ----------
     X, Y : LieGroup
         Elements of one group; batch shapes broadcast.
-    frame : {"right", "left"}
+    side : {"right", "left"}
         As in :func:`compose`.
 
     Returns
@@ -451,7 +438,7 @@ def between(X, Y, *, frame="right"):
     (True, True)
     """
     _same_kind(X, Y, "between")
-    left = _check_frame(frame)
+    left = _check_side(side)
     Z = X.inv().compose(Y)
     J_X = -_ad_inv(Z)
     J_Y = _eye(J_X, X.dof)

@@ -20,6 +20,8 @@ from __future__ import annotations
 
 from ..errors import FrameKeywordError
 from ..functional import splines as _fs
+from ..objects import registry
+from ..objects.registry import stored
 from ..objects.rotation import Rotation
 from ..objects.transform import Transform
 from .interpolation import keyframe_kind, keyframe_times, query_times
@@ -67,11 +69,13 @@ class _Spline:
         _check_order(order, frame)
         q = query_times(times, self.t_min, self.t_max)
         flat = q.reshape(-1)
+        wrap = registry.spec(self.kind).wrap
         if order == 0:
-            return self.kind._wrap(_shape(self._eval(flat, 0), q, self.kind._trail[0]))
+            out = self._eval(flat, 0)
+            return wrap(_shape(out, q, out.shape[-1]))
         rate = self._eval(flat, order)
         if frame == "world":
-            x = self.kind._wrap(self._eval(flat, 0))
+            x = wrap(self._eval(flat, 0))
             rate = x.apply(rate) if self.kind is Rotation else _matvec(x.adjoint(), rate)
         return _shape(rate, q, rate.shape[-1])
 
@@ -119,12 +123,12 @@ class RotationSpline(_Spline):
         self.rotations = rotations
         self.t_min, self.t_max = float(self.times[0]), float(self.times[-1])
         self._coeffs, self.iterations = _fs.rotation_spline_coefficients(
-            self.times, rotations._quat
+            self.times, stored(rotations)
         )
 
     def _eval(self, flat, order):
         return _fs.rotation_spline_eval(
-            self.times, self.rotations._quat, self._coeffs, flat, order
+            self.times, stored(self.rotations), self._coeffs, flat, order
         )
 
 
@@ -171,7 +175,7 @@ class BSplineSO3(_Spline):
         self.t_min, self.t_max = t0, t0 + (len(control_points) - 3) * dt
 
     def _eval(self, flat, order):
-        data = self.control_points._data
+        data = stored(self.control_points)
         return _fs.bspline_so3_eval(data, self.dt, self.t0, flat, order)
 
 
@@ -194,5 +198,5 @@ class BSplineSE3(BSplineSO3):
     kind = Transform
 
     def _eval(self, flat, order):
-        data = self.control_points._data
+        data = stored(self.control_points)
         return _fs.bspline_se3_eval(data, self.dt, self.t0, flat, order)

@@ -28,7 +28,7 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 
 from .._engine import owned_function
-from . import ladder
+from . import ladder, registry
 from ._batch import storage_slots
 
 __all__ = ["Group", "LieGroup"]
@@ -38,8 +38,9 @@ class Group(ABC):
     """A batch of transforms: ``a @ b`` composes them, ``a @ p`` acts on points.
 
     ``@``, :meth:`include` and :meth:`identity` are defined here for every kind (a
-    :class:`~rigidkit.objects._batch.BatchedArray` too). A subclass places itself
-    on the ladder of kinds (:mod:`rigidkit.objects.ladder`) with class keywords,
+    :class:`~rigidkit.objects._batch.BatchedArray` too). A subclass registers
+    itself (:mod:`rigidkit.objects.registry`: its place on the ladder of kinds, and
+    a Lie group's declaration ``_spec``) with class keywords,
     ``class Transform(BatchedArray, LieGroup, family="space", rank=1)``, stores its
     identity element in ``_identity`` and the kernel composing two of its stored
     arrays in ``_compose_kernel``, and implements ``apply`` (to points), ``inv``
@@ -63,7 +64,7 @@ class Group(ABC):
     def __init_subclass__(cls, *, family=None, rank=None, **kwargs):
         super().__init_subclass__(**kwargs)
         if family is not None:
-            ladder.register(cls, family, rank)
+            registry.register(cls, family, rank)
         if cls._compose_kernel is not None:
             cls.__matmul__ = owned_method(
                 cls, cls._compose_kernel, Group.__matmul__, "other"

@@ -15,8 +15,9 @@ method ``include``) and composes them there.
 
 Each class places itself on the ladder when it is defined, with the class keywords
 of :class:`rigidkit.objects.group.Group` (``class Similarity(..., family="space",
-rank=2)``), which call :func:`register`. So this module imports no class, and no
-class imports another to learn its rank: the ranks are read from the registry.
+rank=2)``), which record it in the registry of groups (:mod:`.registry`). So this
+module imports no class, and no class imports another to learn its rank: the
+families and ranks are read from that registry, the one list of groups.
 """
 
 from __future__ import annotations
@@ -24,19 +25,12 @@ from __future__ import annotations
 import numpy as np
 
 from .._engine.namespace import device_of, namespace_of
+from .registry import specs
 
-__all__ = ["register", "kind_of", "compose", "check_included", "homogeneous_matrix"]
+__all__ = ["kind_of", "compose", "check_included", "homogeneous_matrix"]
 
-# class -> (family, rank); filled by each class statement through ``register``.
-_KINDS: dict = {}
-
-
-def register(cls, family: str, rank: int) -> None:
-    """Place ``cls`` on the ladder of ``family`` at ``rank`` (0 = least general)."""
-    for other, place in _KINDS.items():
-        if place == (family, rank) and other.__qualname__ != cls.__qualname__:
-            raise ValueError(f"{other.__name__} already has rank {rank} in {family!r}")
-    _KINDS[cls] = (family, rank)
+# class -> its GroupSpec (family, rank, ...): the registry's own dict, bound once.
+_SPECS = specs()
 
 
 def kind_of(x):
@@ -45,18 +39,18 @@ def kind_of(x):
     The kind is the registered class of ``x``, or of the nearest registered base
     class for a subclass of one.
     """
-    place = _KINDS.get(type(x))
-    if place is not None:  # the common case, a registered class itself
-        return type(x), place[0], place[1]
+    s = _SPECS.get(type(x))
+    if s is not None:  # the common case, a registered class itself
+        return type(x), s.family, s.rank
     for cls in type(x).__mro__[1:]:
-        place = _KINDS.get(cls)
-        if place is not None:
-            return cls, place[0], place[1]
+        s = _SPECS.get(cls)
+        if s is not None:
+            return cls, s.family, s.rank
     return None
 
 
 def _family_names(family: str) -> str:
-    kinds = sorted((rank, cls.__name__) for cls, (f, rank) in _KINDS.items() if f == family)
+    kinds = sorted((s.rank, c.__name__) for c, s in _SPECS.items() if s.family == family)
     return ", ".join(name for _, name in kinds)
 
 
@@ -87,7 +81,8 @@ def compose(a, b):
 def check_included(cls, x, what: str) -> None:
     """Raise :class:`TypeError` unless ``x`` is of a kind included in ``cls``."""
     kx = kind_of(x)
-    family, rank = next(_KINDS[c] for c in cls.__mro__ if c in _KINDS)
+    s = next(_SPECS[c] for c in cls.__mro__ if c in _SPECS)
+    family, rank = s.family, s.rank
     if kx is None or kx[1] != family or kx[2] > rank:
         raise TypeError(f"{what} takes a transform of a kind included in {cls.__name__}")
 

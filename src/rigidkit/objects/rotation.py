@@ -21,11 +21,14 @@ from ..functional import euler
 from ..functional import interpolation as _interp
 from ..functional import rot6d as _r6
 from ..functional import sequences as _seq
+from ..functional import so3 as _so3
 from ..functional import swing_twist as _st
 from ..functional import symmetry as _sym
+from ..kernels.kinematics import integration as _ki
 from ._batch import BatchedArray, batch_shape
 from ._frozen import frozen
 from .group import LieGroup
+from .registry import GroupSpec
 
 __all__ = ["Rotation", "geodesic_distance", "chordal_distance"]
 
@@ -56,6 +59,12 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
     _compose_kernel = _conv.quat_compose
     _inverse_kernel = _conv.quat_conjugate
     dof, matrix_size, point_dim = 3, 3, 3
+    _spec = GroupSpec(
+        algebra=_so3,
+        tangent=(("rotation", slice(0, 3)),),
+        rate="angular velocity",
+        step=(_ki.so3_increment, _ki.so3_increment_rk4, _ki.so3_chain),
+    )
 
     def __init__(self, quat, *, _normalized=False):
         if not _normalized:

@@ -18,8 +18,10 @@ from .._validate import as_array, check_finite, finite_array, to_numpy
 from ..errors import ShapeError
 from ..functional import so2 as _so2
 from ..kernels import so2 as _k
+from ..kernels.kinematics import planar as _kp
 from ._batch import BatchedArray, batch_shape
 from .group import LieGroup
+from .registry import GroupSpec
 
 __all__ = ["Rotation2D"]
 
@@ -56,6 +58,13 @@ class Rotation2D(BatchedArray, LieGroup, family="plane", rank=0):
     _compose_kernel = _k.complex_multiply
     _inverse_kernel = _k.complex_conjugate
     dof, matrix_size, point_dim = 1, 2, 2
+    # SO(2) commutes: its integration steps are angles, summed (no chain).
+    _spec = GroupSpec(
+        algebra=_so2,
+        tangent=(("rotation", slice(0, 1)),),
+        rate="angular velocity",
+        step=(_kp.so2_increment, _kp.so2_increment_rk4, None),
+    )
 
     def __init__(self, cos_sin):
         self._data = _so2.complex_normalize(cos_sin, what="(cos, sin) pair")

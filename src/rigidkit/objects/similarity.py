@@ -27,6 +27,7 @@ from ._frozen import frozen
 from .affine import Affine
 from .group import LieGroup
 from .projective import Projective
+from .registry import GroupSpec
 from .rotation import Rotation
 from .transform import pose_gap
 
@@ -68,6 +69,14 @@ class Similarity(BatchedArray, LieGroup, family="space", rank=2):
     _identity = (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)  # (q, t, s)
     _compose_kernel = _k.sim3_compose
     dof, matrix_size, point_dim = 7, 4, 3
+    _spec = GroupSpec(
+        algebra=_fsim3,
+        tangent=(
+            ("translation", slice(0, 3)),
+            ("rotation", slice(3, 6)),
+            ("scale", slice(6, 7)),
+        ),
+    )
 
     def __init__(self, scale=None, rotation=None, translation=None):
         if rotation is not None and not isinstance(rotation, Rotation):

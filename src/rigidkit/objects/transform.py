@@ -2,8 +2,9 @@
 
 Conventions: a transform ``A_T_B`` maps points of frame B to frame A,
 ``p_A = A_T_B @ p_B = R p_B + t``; ``A_T_C = A_T_B @ B_T_C`` applies ``B_T_C`` first.
-Quaternions are Hamilton, scalar first; twists are ordered ``(v, w)`` as in the
-notes (scipy's exponential coordinates are ``(w, v)``).
+Quaternions are Hamilton, scalar first; twists are ordered ``(v, w)`` as in Murray,
+Li & Sastry 1994 (Sec. 2.3) and Barfoot 2017 (scipy's exponential coordinates are
+``(w, v)``).
 """
 
 from __future__ import annotations
@@ -19,9 +20,11 @@ from ..functional import screw as _screw
 from ..functional import se3 as _se3
 from ..kernels import pose_formats as _kpf
 from ..kernels import se3 as _k
+from ..kernels.kinematics import integration as _ki
 from ._batch import BatchedArray, batch_shape
 from ._frozen import frozen
 from .group import LieGroup, owned_method
+from .registry import GroupSpec
 from .rotation import Rotation
 
 __all__ = ["Transform"]
@@ -67,6 +70,12 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
     _compose_kernel = _k.pose_compose
     _inverse_kernel = _k.pose_inv
     dof, matrix_size, point_dim = 6, 4, 3
+    _spec = GroupSpec(
+        algebra=_se3,
+        tangent=(("translation", slice(0, 3)), ("rotation", slice(3, 6))),
+        rate="twist",
+        step=(_ki.se3_increment, _ki.se3_increment_rk4, _ki.se3_chain),
+    )
 
     def __init__(self, rotation=None, translation=None):
         if rotation is not None and not isinstance(rotation, Rotation):

@@ -14,9 +14,11 @@ from .._engine.namespace import float_dtype_of, namespace_of
 from .._validate import as_array, finite_array, to_numpy
 from ..functional import se2 as _se2
 from ..kernels import se2 as _k
+from ..kernels.kinematics import planar as _kp
 from ._batch import BatchedArray, batch_shape
 from ._frozen import frozen
 from .group import LieGroup
+from .registry import GroupSpec
 from .rotation2d import Rotation2D
 
 __all__ = ["Transform2D"]
@@ -61,6 +63,12 @@ class Transform2D(BatchedArray, LieGroup, family="plane", rank=1):
     _compose_kernel = _k.pose_multiply
     _inverse_kernel = _k.pose_inverse
     dof, matrix_size, point_dim = 3, 3, 2
+    _spec = GroupSpec(
+        algebra=_se2,
+        tangent=(("translation", slice(0, 2)), ("rotation", slice(2, 3))),
+        rate="planar twist",
+        step=(_kp.se2_increment, _kp.se2_increment_rk4, _kp.se2_chain),
+    )
 
     def __init__(self, rotation=None, translation=None):
         if rotation is not None and not isinstance(rotation, Rotation2D):

@@ -37,8 +37,7 @@ import numpy as np
 from ..._engine.namespace import device_of, is_numpy, namespace_of
 from ..._validate import finite_array
 from ...errors import ShapeError
-from ...kernels.kinematics import integration as _k
-from ...kernels.kinematics import planar as _kp
+from ...objects import registry
 from ...objects.rotation import Rotation
 from ...objects.transform import Transform
 from . import _scan
@@ -85,37 +84,32 @@ def _increments(one, rk4, method, rate, h):
     return rk4(rate, mid, end, h)
 
 
-#: Per group: the rate's width and name, the step kernels (one step, RKMK4) and the
-#: chain of the running product (None for SO(2), whose steps are angles, summed).
-GROUPS = {
-    "so3": (3, "angular velocity", _k.so3_increment, _k.so3_increment_rk4, _k.so3_chain),
-    "se3": (6, "twist", _k.se3_increment, _k.se3_increment_rk4, _k.se3_chain),
-    "so2": (1, "angular velocity", _kp.so2_increment, _kp.so2_increment_rk4, None),
-    "se2": (3, "planar twist", _kp.se2_increment, _kp.se2_increment_rk4, _kp.se2_chain),
-}
+def integrate(X0, rate, dt, method, fn, body=0):
+    """The trajectory, shape (..., N + 1), of the Lie group of ``X0`` from ``X0``.
 
-
-def integrate(group, x0, rate, dt, method, fn, body=0):
-    """The trajectory ``(..., N + 1, W)`` of ``group`` from ``x0`` (..., W).
-
-    Shared by every group (``x0`` in the group's storage: quaternions, poses,
-    complex numbers): validates the rates (``(..., N, width)``), the steps and
-    the method, makes the increments (:func:`_increments`) and chains them
-    (:func:`._scan.running_product`). For SO(2) the result is ``x0`` and the
-    running sums of the angle increments, shape (..., N + 1, 1).
+    Shared by every group: the group's declaration (``GroupSpec.step`` and
+    ``rate``, :mod:`rigidkit.objects.registry`) gives the step kernels and the
+    rate's name. Validates the rates (``(..., N, dof)``), the steps and the
+    method, makes the increments (:func:`_increments`) and chains them
+    (:func:`._scan.running_product`). For a commutative group (no chain: SO(2))
+    the increments are tangents, summed (:func:`._scan.running_sum`), and the
+    trajectory is ``X0 exp(sum)``.
     """
-    width, what, one, rk4, chain = GROUPS[group]
+    spec = registry.spec(type(X0))
+    one, rk4, chain = spec.step
     if rk4.params:
         rk4 = partial(rk4, body)
     _method(method, fn)
-    r = _samples(rate, width, what, fn)
+    r = _samples(rate, spec.dof, spec.rate, fn)
     h = _steps(dt, r, fn)
-    x0 = _like(x0, r)
+    x0 = _like(registry.stored(X0), r)
     if chain is None:
-        return x0, _scan.running_sum(_increments(one, rk4, method, r, h))
+        tau = _scan.running_sum(_increments(one, rk4, method, r, h))
+        return spec.wrap(x0[..., None, :]).compose(spec.cls.exp(tau))
     # Asked for before the increments are made: a cached scan loads meanwhile.
     _scan.prepare(chain, x0, r, r.shape[-2])
-    return _scan.running_product(chain, body, x0, _increments(one, rk4, method, r, h))
+    x = _scan.running_product(chain, body, x0, _increments(one, rk4, method, r, h))
+    return spec.wrap(x)
 
 
 def _samples(rate, width, what, fn):
@@ -174,9 +168,8 @@ def integrate_angular_velocity(R0, omega, dt, *, frame=None, method="exact"):
     fn = "integrate_angular_velocity"
     body = body_flag(frame, fn)
     as_object = isinstance(R0, Rotation)
-    q0 = R0.as_quat() if as_object else Rotation.from_matrix(rotation_matrix(R0)).as_quat()
-    q = integrate("so3", q0, omega, dt, method, fn, body)
-    traj = Rotation._wrap(q)
+    X0 = R0 if as_object else Rotation.from_matrix(rotation_matrix(R0))
+    traj = integrate(X0, omega, dt, method, fn, body)
     return traj if as_object else traj.as_matrix()
 
 
@@ -217,12 +210,8 @@ def integrate_twist(T0, twist, dt, *, frame=None, method="exact"):
     fn = "integrate_twist"
     body = body_flag(frame, fn)
     as_object = isinstance(T0, Transform)
-    if as_object:
-        p0 = T0._pose
-    else:
-        p0 = Transform.from_matrix(homogeneous_matrix(T0))._pose
-    p = integrate("se3", p0, twist, dt, method, fn, body)
-    traj = Transform._wrap(p)
+    X0 = T0 if as_object else Transform.from_matrix(homogeneous_matrix(T0))
+    traj = integrate(X0, twist, dt, method, fn, body)
     return traj if as_object else traj.as_matrix()
 
 

@@ -7,7 +7,9 @@ notes' ``e^{J omega t}``: the additive property ``F(t) F(s) = F(t + s)`` makes
 (shape (..., 1), like the so(2) tangent vectors). Planar twists are
 ``(vx, vy, omega)`` with ``T' = hat(V) T`` (world) or ``T hat(V)`` (body),
 ``V_world = Ad_T V_body``. Sampled rates integrate into trajectories as in 3D
-(:func:`integrate_angular_velocity`, :func:`integrate_twist`).
+(:func:`integrate_angular_velocity`, :func:`integrate_twist`), and sampled
+trajectories give their velocities (:func:`angular_velocity_from_samples`,
+:func:`twist_from_samples`).
 
 >>> import numpy as np
 >>> R = np.array([[0.0, -1.0], [1.0, 0.0]])          # theta = pi/2
@@ -21,11 +23,11 @@ from __future__ import annotations
 from ...functional import se2 as _se2
 from ...functional import so2 as _so2
 from ...kernels.kinematics import planar as _k
-from ...kernels import so2 as _kso2
 from ...objects.rotation2d import Rotation2D
 from ...objects.transform2d import Transform2D
 from ._common import body_flag, vector
 from .integration import integrate
+from .samples import velocity_from_samples
 
 __all__ = [
     "angular_velocity",
@@ -38,6 +40,8 @@ __all__ = [
     "point_acceleration",
     "integrate_angular_velocity",
     "integrate_twist",
+    "angular_velocity_from_samples",
+    "twist_from_samples",
 ]
 
 
@@ -296,12 +300,10 @@ def integrate_angular_velocity(R0, omega, dt, *, frame=None, method="exact"):
     ((101,), 1.570796326795)
     """
     fn = "planar.integrate_angular_velocity"
-    body_flag(frame, fn)
+    body = body_flag(frame, fn)
     as_object = isinstance(R0, Rotation2D)
-    z0 = (R0 if as_object else Rotation2D.from_matrix(_rotation(R0)))._data
-    z0, theta = integrate("so2", z0, omega, dt, method, fn)
-    z = _kso2.complex_multiply(z0[..., None, :], _kso2.complex_from_angle(theta))
-    traj = Rotation2D._wrap(z)
+    X0 = R0 if as_object else Rotation2D.from_matrix(_rotation(R0))
+    traj = integrate(X0, omega, dt, method, fn, body)
     return traj if as_object else traj.as_matrix()
 
 
@@ -342,7 +344,80 @@ def integrate_twist(T0, twist, dt, *, frame=None, method="exact"):
     fn = "planar.integrate_twist"
     body = body_flag(frame, fn)
     as_object = isinstance(T0, Transform2D)
-    p0 = (T0 if as_object else Transform2D.from_matrix(_transform(T0)))._data
-    p = integrate("se2", p0, twist, dt, method, fn, body)
-    traj = Transform2D._wrap(p)
+    X0 = T0 if as_object else Transform2D.from_matrix(_transform(T0))
+    traj = integrate(X0, twist, dt, method, fn, body)
     return traj if as_object else traj.as_matrix()
+
+
+def angular_velocity_from_samples(rotations, times, *, frame=None):
+    """Planar angular velocity at each sample of an orientation trajectory.
+
+    The finite differences on the group of
+    :func:`rigidkit.kinematics.angular_velocity_from_samples` (one algorithm for
+    every group, :func:`.samples.velocity_from_samples`): second-order accurate,
+    exact for a constant rate when every step turns by less than pi.
+
+    Parameters
+    ----------
+    rotations : Rotation2D of shape (..., N), or array_like (..., N, 2, 2)
+        Orientations ``W_R_B`` at the sample times.
+    times : array_like, shape (N,) or (..., N)
+        Strictly increasing (non-uniform allowed).
+    frame : {"world", "body"}
+        Required for uniformity with 3D (the two agree in the plane).
+
+    Returns
+    -------
+    array, shape (..., N, 1)
+        Radians per unit time, counter-clockwise.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import rigidkit as rk
+    >>> t = np.array([0.0, 0.1, 0.3, 0.4])
+    >>> R = rk.Rotation2D.from_angle(2.0 * t)
+    >>> np.round(angular_velocity_from_samples(R, t, frame="world")[:, 0], 12)
+    array([2., 2., 2., 2.])
+    """
+    fn = "planar.angular_velocity_from_samples"
+    body = body_flag(frame, fn)
+    if not isinstance(rotations, Rotation2D):
+        rotations = Rotation2D.from_matrix(_rotation(rotations))
+    return velocity_from_samples(rotations, times, body, fn, "rotations")
+
+
+def twist_from_samples(transforms, times, *, frame=None):
+    """Planar twist ``(vx, vy, omega)`` at each sample of a pose trajectory.
+
+    The finite differences on the group of
+    :func:`rigidkit.kinematics.twist_from_samples`.
+
+    Parameters
+    ----------
+    transforms : Transform2D of shape (..., N), or array_like (..., N, 3, 3)
+        Poses ``W_T_B`` at the sample times.
+    times : array_like, shape (N,) or (..., N)
+        Strictly increasing.
+    frame : {"world", "body"}
+        World: ``hat(V) = T' T^-1``; body: ``T^-1 T'``.
+
+    Returns
+    -------
+    array, shape (..., N, 3)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import rigidkit as rk
+    >>> V = np.array([2.0, 0.0, 1.0])              # forward at 2, turning at 1 rad/s
+    >>> t = np.linspace(0.0, 2.0, 5)
+    >>> T = rk.Transform2D.exp(t[:, None] * V)
+    >>> np.round(twist_from_samples(T, t, frame="body")[2], 12) + 0.0
+    array([2., 0., 1.])
+    """
+    fn = "planar.twist_from_samples"
+    body = body_flag(frame, fn)
+    if not isinstance(transforms, Transform2D):
+        transforms = Transform2D.from_matrix(_transform(transforms))
+    return velocity_from_samples(transforms, times, body, fn, "transforms")

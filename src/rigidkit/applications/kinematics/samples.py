@@ -1,8 +1,10 @@
 """Velocities from sampled orientations and poses: finite differences on the group.
 
+One algorithm for every Lie group (:func:`velocity_from_samples`, used by the
+functions of SO(3) and SE(3) here and of SO(2) and SE(2) in :mod:`.planar`).
 Between samples ``k`` and ``k + 1`` the increment is a logarithm: body
-``log(R_k^T R_{k+1})``, world ``log(R_{k+1} R_k^T)`` (for poses ``log(T_k^-1
-T_{k+1})`` and ``log(T_{k+1} T_k^-1)``); divided by the step it is the mean
+``log(X_k^-1 X_{k+1})``, world ``log(X_{k+1} X_k^-1)`` (``R^T`` for ``R^-1`` of a
+rotation); divided by the step it is the mean
 velocity over the step, which equals the velocity at the step's middle to second
 order (the bracket terms of the Magnus series are third order in the step). A
 one-parameter motion's increment is the same vector whichever of its two ends
@@ -26,9 +28,7 @@ import numpy as np
 from ..._engine.namespace import device_of, is_numpy, namespace_of
 from ..._validate import finite_array
 from ...errors import DegenerateInputError, ShapeError
-from ...functional import conversions as _conv
-from ...functional import quaternion as _fq
-from ...kernels import se3 as _se3
+from ...objects.registry import stored
 from ...objects.rotation import Rotation
 from ...objects.transform import Transform
 from ._common import body_flag, homogeneous_matrix, rotation_matrix
@@ -81,6 +81,48 @@ def _check_count(n, fn):
         )
 
 
+def velocity_from_samples(X, times, body, fn, what):
+    """The velocity (a tangent per unit time) at each sample of ``X``, any Lie group.
+
+    Parameters
+    ----------
+    X : LieGroup of shape (..., N)
+        The samples (any registered Lie group, :mod:`rigidkit.objects.registry`).
+    times : array_like, shape (N,) or (..., N)
+        Strictly increasing.
+    body : int
+        1 for body velocities (``X^-1 X'``), 0 for world ones (``X' X^-1``).
+    fn, what : str
+        The public function's name and what ``X`` holds, for the messages.
+
+    Returns
+    -------
+    array, shape (..., N, dof)
+    """
+    if X.single:
+        raise ShapeError(f"{fn}: {what} need a time axis, shape (..., N); got a single one")
+    n = X.shape[-1]
+    _check_count(n, fn)
+    h = _times(times, n, stored(X), fn)
+    a, b = X[..., :-1], X[..., 1:]
+    # compose, not @: TorchDynamo cannot trace @ on objects
+    rel = a.inv().compose(b) if body else b.compose(a.inv())
+    d = rel.log() / h[..., None]
+    if not body or n < 3:
+        return _combine(d, h, namespace_of(d))
+    # A body increment is in the axes of its own step; the one-sided ends combine
+    # two steps, so the second is turned into the axes of the end sample (then
+    # V_world = Ad_X V_body holds at every sample, as in the world frame).
+    second = _adjoint_apply(rel[..., :1], d[..., 1:2, :])
+    before_last = _adjoint_apply(rel[..., -1:].inv(), d[..., -2:-1, :])
+    return _combine(d, h, namespace_of(d), second, before_last)
+
+
+def _adjoint_apply(X, tau):
+    """``Ad_X tau`` for group elements (...) and tangents (..., dof)."""
+    return (X.adjoint() @ tau[..., None])[..., 0]
+
+
 def angular_velocity_from_samples(rotations, times, *, frame=None):
     """Angular velocity at each sample of an orientation trajectory.
 
@@ -111,33 +153,9 @@ def angular_velocity_from_samples(rotations, times, *, frame=None):
     """
     fn = "angular_velocity_from_samples"
     body = body_flag(frame, fn)
-    if isinstance(rotations, Rotation):
-        q = rotations.as_quat()
-    else:
-        q = Rotation.from_matrix(rotation_matrix(rotations)).as_quat()
-    if q.ndim < 2:
-        raise ShapeError(
-            f"{fn}: rotations need a time axis, shape (..., N); got a single one"
-        )
-    n = q.shape[-2]
-    _check_count(n, fn)
-    h = _times(times, n, q, fn)
-    a, b = q[..., :-1, :], q[..., 1:, :]
-    # body: q_k* q_{k+1}; world: q_{k+1} q_k*
-    rel = (
-        _fq.multiply(_conv.quat_conjugate(a), b)
-        if body
-        else _fq.multiply(b, _conv.quat_conjugate(a))
-    )
-    d = _conv.rotvec_from_quat(rel) / h[..., None]
-    if not body or n < 3:
-        return _combine(d, h, namespace_of(d))
-    # A body increment is in the axes of its own step; the one-sided ends combine
-    # two steps, so the second is turned into the axes of the end sample (then
-    # omega_world = R omega_body holds at every sample, as in the world frame).
-    second = _conv.quat_apply(rel[..., :1, :], d[..., 1:2, :])
-    before_last = _conv.quat_apply(_conv.quat_conjugate(rel[..., -1:, :]), d[..., -2:-1, :])
-    return _combine(d, h, namespace_of(d), second, before_last)
+    if not isinstance(rotations, Rotation):
+        rotations = Rotation.from_matrix(rotation_matrix(rotations))
+    return velocity_from_samples(rotations, times, body, fn, "rotations")
 
 
 def twist_from_samples(transforms, times, *, frame=None):
@@ -168,33 +186,6 @@ def twist_from_samples(transforms, times, *, frame=None):
     """
     fn = "twist_from_samples"
     body = body_flag(frame, fn)
-    if isinstance(transforms, Transform):
-        p = transforms._pose
-    else:
-        p = Transform.from_matrix(homogeneous_matrix(transforms))._pose
-    if p.ndim < 2:
-        raise ShapeError(
-            f"{fn}: transforms need a time axis, shape (..., N); got a single one"
-        )
-    n = p.shape[-2]
-    _check_count(n, fn)
-    h = _times(times, n, p, fn)
-    a, b = p[..., :-1, :], p[..., 1:, :]
-    rel = (
-        _se3.pose_compose(_se3.pose_inv(a), b)
-        if body
-        else _se3.pose_compose(b, _se3.pose_inv(a))
-    )
-    d = _se3.twist_from_pose(rel) / h[..., None]
-    if not body or n < 3:
-        return _combine(d, h, namespace_of(d))
-    # As for rotations: the second step's twist in the axes of the end sample.
-    second = _adjoint_apply(rel[..., :1, :], d[..., 1:2, :])
-    before_last = _adjoint_apply(_se3.pose_inv(rel[..., -1:, :]), d[..., -2:-1, :])
-    return _combine(d, h, namespace_of(d), second, before_last)
-
-
-def _adjoint_apply(pose, twist):
-    """``Ad_T V`` for poses (..., 7) and twists (..., 6)."""
-    Ad = _se3.adjoint_from_pose(pose)
-    return (Ad @ twist[..., None])[..., 0]
+    if not isinstance(transforms, Transform):
+        transforms = Transform.from_matrix(homogeneous_matrix(transforms))
+    return velocity_from_samples(transforms, times, body, fn, "transforms")
