@@ -25,6 +25,7 @@ import pytest
 sp = pytest.importorskip("sympy")
 
 import rigidkit as rk  # noqa: E402
+from rigidkit.objects import registry  # noqa: E402
 
 S = rk.symbolic
 TOL = 1e-13
@@ -42,8 +43,9 @@ def _se2_vee(M):
     return [M[0, 2], M[1, 2], M[1, 0]]
 
 
-# group: (dimension, exp as a matrix of symbols, vee, symbolic namespace)
-GROUPS = {
+# The reference of each group: (dimension, exp as a matrix of symbols, vee, symbolic
+# namespace). Which groups are tested is read from the registry (below), not from here.
+REFERENCES = {
     "so3": (3, lambda x: S.matrix_from_rotvec(x), _so3_vee, S.so3),
     "se3": (6, lambda x: S.se3.matrix_from_pose(S.se3.pose_from_twist(x)), _se3_vee, S.se3),
     "se2": (3, lambda x: S.se2.matrix_from_pose(S.se2.pose_from_twist(x)), _se2_vee, S.se2),
@@ -52,7 +54,7 @@ GROUPS = {
 
 @functools.cache
 def _exp_and_derivatives(group):
-    n, exp, _, _ = GROUPS[group]
+    n, exp, _, _ = REFERENCES[group]
     x = sp.symbols(f"x0:{n}", real=True)
     X = sp.Matrix(exp(sp.Matrix(x)))
     return x, X, [X.diff(xi) for xi in x]
@@ -64,7 +66,7 @@ def _at(M, sub):
 
 def _reference(group, point):
     """``(J_l, J_r)`` at ``point`` from the derivatives of the exponential."""
-    _, _, vee, _ = GROUPS[group]
+    _, _, vee, _ = REFERENCES[group]
     x, X, dX = _exp_and_derivatives(group)
     sub = {xi: sp.Float(v, 30) for xi, v in zip(x, point, strict=True)}
     Xn = _at(X, sub)
@@ -76,7 +78,7 @@ def _reference(group, point):
 
 
 def _points(group, rng):
-    n = GROUPS[group][0]
+    n = REFERENCES[group][0]
     for scale in (0.3, 1.0, 2.5):
         p = rng.standard_normal(n)
         rot = p[-3:] if group != "se2" else p[-1:]
@@ -94,9 +96,20 @@ def _eval(fn, point, closed_form):
     return np.array(sp.Matrix(M).evalf(30).tolist(), dtype=float)
 
 
-@pytest.mark.parametrize("group", sorted(GROUPS))
+def _symbolic_groups():
+    """The Lie groups of the registry whose symbolic namespace has the Jacobians."""
+    names = []
+    for cls in registry.groups(lie=True):
+        name = registry.spec(cls).algebra.__name__.rpartition(".")[2]
+        if hasattr(getattr(S, name, None), "left_jacobian"):
+            names.append(name)
+    return names
+
+
+@pytest.mark.parametrize("group", _symbolic_groups())
 def test_jacobians_are_derivatives_of_exp(group):
-    ns = GROUPS[group][3]
+    assert group in REFERENCES, f"symbolic {group} Jacobians: add its exp to REFERENCES"
+    ns = REFERENCES[group][3]
     rng = np.random.default_rng(sum(map(ord, group)))
     for point, small in _points(group, rng):
         left, right = _reference(group, point)
