@@ -42,7 +42,7 @@ import importlib
 import pkgutil
 from dataclasses import dataclass, replace
 
-__all__ = ["GroupSpec", "register", "spec", "groups", "stored"]
+__all__ = ["GroupSpec", "register", "spec", "specs", "groups", "stored"]
 
 
 @dataclass(frozen=True)
@@ -78,9 +78,8 @@ class GroupSpec:
     wrap : callable
         ``wrap(data)``: an object of the class holding ``data`` (its stored
         layout, ``batch + the element's shape``), not validated. It is the class's
-        own ``_wrap``, so a hot path that binds it once pays no extra call.
-        (Read when asked, not at registration: ``BatchedArray`` sets a class's
-        ``_wrap`` after ``Group`` has registered it.)
+        own ``_wrap`` (read from the class when asked, so it is the class's final
+        one), so a hot path that binds it once pays no extra call.
     """
 
     algebra: object = None
@@ -101,6 +100,7 @@ class GroupSpec:
 
     @property
     def wrap(self):
+        """``wrap(data)``: an object of the class holding ``data``, not validated."""
         return self.cls._wrap
 
     def part(self, name: str):
