@@ -106,7 +106,7 @@ class TestSO2:
     def test_exp_is_expm_of_hat(self):
         w = np.linspace(-3, 3, 13)[:, None]
         np.testing.assert_allclose(rk.so2.exp(w), expm_batch(rk.so2.hat(w)), atol=1e-14)
-        # the notes' exp(ω J t): hat(ω) = ω J with J = R(pi/2)
+        # exp(ω J t): hat(ω) = ω J with J = R(pi/2)
         J = np.array([[0.0, -1.0], [1.0, 0.0]])
         np.testing.assert_allclose(rk.so2.hat([0.7]), 0.7 * J)
         np.testing.assert_allclose(rk.so2.hat([1.0]), rot_matrix(math.pi / 2), atol=1e-16)

@@ -2,12 +2,12 @@
 
 Independent references:
 
-* the elementary rotations of the notes (1-1-1 .. 1-1-3), multiplied in the order
+* the elementary rotations ``Rx``, ``Ry``, ``Rz`` written out, multiplied in the order
   "right-multiply body, left-multiply world": intrinsic ``"XYZ"`` is
   ``Rx @ Ry @ Rz``, extrinsic ``"xyz"`` is ``Rz @ Ry @ Rx``;
 * ``scipy.spatial.transform.Rotation`` (conventions, all 24 sequences);
-* the notes' closed forms ``R_XYZ`` (with the erratum of DESIGN.md corrected) and
-  ``R_ZYX``;
+* the closed forms of ``R_XYZ`` (with docs/errata.md E1 corrected) and ``R_ZYX``,
+  written out by hand;
 * mpmath at 50+ digits: the rotation of exact angles (products of axis
   quaternions), the exact Euler angles of a float quaternion (Newton's method on
   that product, which never uses our inverse formulas), and the angle between
@@ -86,7 +86,7 @@ def wrap(d):
     return np.angle(np.exp(1j * np.asarray(d, dtype=np.float64)))
 
 
-# -- elementary rotations, written out from the notes (1-1-1 .. 1-1-3) ---------------
+# -- elementary rotations, written out ----------------------------------------------
 def elementary(axis, t):
     c, s = np.cos(t), np.sin(t)
     one, zero = np.ones_like(t), np.zeros_like(t)
@@ -270,8 +270,8 @@ def test_intrinsic_equals_extrinsic_reversed(upper, rng):
     np.testing.assert_allclose(wrap(back[:, ::-1] - a), 0.0, atol=1e-13)
 
 
-def test_notes_closed_forms():
-    """Seed 004, (2-1-1) with the erratum of DESIGN.md corrected, and (2-1-2)."""
+def test_closed_forms_r_xyz_and_r_zyx():
+    """``R_XYZ = Rx Ry Rz`` and ``R_ZYX = Rz Ry Rx`` written out (docs/errata.md E1)."""
     phi, theta, psi = 0.7, -0.4, 2.3  # about x, y, z
     c, s = math.cos, math.sin
     cf, sf, ct, st_, cp, sp = c(phi), s(phi), c(theta), s(theta), c(psi), s(psi)
@@ -294,7 +294,8 @@ def test_notes_closed_forms():
     got_zyx = euler.matrix_from_euler("ZYX", [psi, theta, phi])
     np.testing.assert_allclose(got_xyz, R_XYZ, rtol=0, atol=TOL64)
     np.testing.assert_allclose(got_zyx, R_ZYX, rtol=0, atol=TOL64)
-    # The notes' printed entry, c(phi) s(psi) s(theta) + s(phi) c(phi), is wrong.
+    # The printed entry of docs/errata.md E1, c(phi) s(psi) s(theta) + s(phi) c(phi),
+    # is wrong.
     assert abs(got_xyz[2, 1] - (cf * sp * st_ + sf * cf)) > 0.1
 
 

@@ -1,8 +1,9 @@
 """Rotation derivatives, quaternion kinematics, twists, points, screws, the plane (issue 8).
 
 References: finite differences of scipy.linalg.expm along one-parameter motions
-(``R(t) = exp(hat(w) t) R0``), scipy's Rotation, the notes' relations (004 1.4,
-000 C-E with their errata corrected), group identities.
+(``R(t) = exp(hat(w) t) R0``), scipy's Rotation, the velocity relations of Murray,
+Li & Sastry 1994 (Sec. 2.4), group identities; the lecture-note forms of
+docs/errata.md (E3, E5) are shown wrong.
 """
 
 import numpy as np
@@ -55,9 +56,9 @@ def motion(rng):
 # -- rotation matrices -------------------------------------------------------------------
 
 
-def test_angular_velocity_four_forms_of_the_notes(motion):
-    """004 1.4: A_R_B' = hat(w_A) A_R_B = A_R_B hat(w_B); B_R_A' = -B_R_A hat(w_A)
-    = -hat(w_B) B_R_A, with w_A = A_R_B w_B."""
+def test_angular_velocity_four_forms(motion):
+    """A_R_B' = hat(w_A) A_R_B = A_R_B hat(w_B); B_R_A' = -B_R_A hat(w_A)
+    = -hat(w_B) B_R_A, with w_A = A_R_B w_B (Murray, Li & Sastry 1994, Sec. 2.4.1)."""
     A_R_B = motion(0.0)
     R_dot = fd(motion)
     w_A = K.angular_velocity(A_R_B, R_dot, frame="world")
@@ -99,14 +100,14 @@ def test_angular_acceleration_and_second_derivative(motion):
             return K.angular_velocity(motion(t), fd(motion, t), frame=frame)
 
         np.testing.assert_allclose(alpha, fd(w_t, h=1e-3), atol=1e-6)
-        # matrix form of the notes (000 D.3), corrected: R'' = (hat(alpha) + hat(w)^2) R
+        # matrix form: R'' = (hat(alpha) + hat(w)^2) R
         np.testing.assert_allclose(
             K.rotation_second_derivative(R0, w, alpha, frame=frame), R_ddot, atol=1e-6
         )
     A = hat(K.angular_acceleration(R0, R_dot, R_ddot, frame="world"))
     W = hat(K.angular_velocity(R0, R_dot, frame="world"))
     np.testing.assert_allclose((A + W @ W) @ R0, R_ddot, atol=1e-6)
-    # the notes' uncorrected (hat(w) + hat(w)^2) R is not the second derivative
+    # (hat(w) + hat(w)^2) R (docs/errata.md E3) is not the second derivative
     assert np.abs((W + W @ W) @ R0 - R_ddot).max() > 0.1
 
 
@@ -146,7 +147,7 @@ def test_quaternion_derivative_against_finite_differences(rng):
                 w,
                 atol=1e-14,
             )
-    # 004 2.3: q0' = -q.w/2, q_vec' = (q0 I + hat(q)) w / 2 (body)
+    # q' = q (0, w) / 2: q0' = -q.w/2, q_vec' = (q0 I + hat(q)) w / 2 (body)
     qd = K.quaternion_derivative(q0, w, frame="body")
     np.testing.assert_allclose(qd[0], -0.5 * q0[1:] @ w, atol=1e-16)
     np.testing.assert_allclose(
@@ -246,7 +247,7 @@ def test_spatial_acceleration_corrected(pose_motion):
 
     T_ddot_b = K.transform_second_derivative(T0, Vb, fd(Vb_t, h=1e-3), frame="body")
     np.testing.assert_allclose(T_ddot_b, fd2(T), atol=1e-6)
-    # the notes' form, hat(V) + hat(V)^2 on [q; 0], is not the acceleration
+    # hat(V) + hat(V)^2 on [q; 0] (docs/errata.md E5) is not the acceleration
     wrong = (hat6(Vw) + hat6(Vw) @ hat6(Vw)) @ np.append(q_world[:3], 0.0)
     assert np.abs(wrong - fd2(point)).max() > 1e-2
 
@@ -311,8 +312,8 @@ def test_pure_translation_screw():
 # -- the plane ---------------------------------------------------------------------------
 
 
-def test_planar_kinematics_of_the_notes():
-    """000 A.3 and D.3: R(t) = exp(w J t), R'(0) = w J; q'' = [[-w^2, -a], [a, -w^2]] q."""
+def test_planar_kinematics():
+    """R(t) = exp(w J t), R'(0) = w J; q'' = [[-w^2, -a], [a, -w^2]] q (a = w')."""
     P = K.planar
     J = np.array([[0.0, -1.0], [1.0, 0.0]])
     w, a = 1.7, 0.4

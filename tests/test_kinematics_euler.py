@@ -1,9 +1,10 @@
 """Euler-angle rates (issue 8 §2): E, E^-1, E' for all 24 sequences and both frames.
 
 References: central finite differences of scipy's ``from_euler`` (independent of
-rigidkit), the notes' closed forms (000 D.2, 004 2.1, verified correct in
-DESIGN.md), the group relation ``omega_world = R omega_body``, and the
-singularities.
+rigidkit), closed forms written out by hand (the world matrix of intrinsic
+``"XYZ"``, whose columns are the axes ``x``, ``Rx y``, ``Rx Ry z``; the world and
+body matrices of ``"ZYX"`` and their inverses), the group relation
+``omega_world = R omega_body``, and the singularities.
 """
 
 import itertools
@@ -116,8 +117,8 @@ def test_rate_matrix_derivative_and_acceleration(seq, frame, rng):
     np.testing.assert_allclose(back, acc, atol=1e-11)
 
 
-def test_notes_closed_forms():
-    """000 D.2 (XYZ, space frame) and 004 2.1 (ZYX world and body, and inverses)."""
+def test_closed_forms():
+    """XYZ in world axes, and ZYX in world and body axes with their inverses."""
     al, be, ga = 0.3, -0.4, 1.1
     c, s = np.cos, np.sin
     xyz = np.array([[1, 0, s(be)], [0, c(al), -s(al) * c(be)], [0, s(al), c(al) * c(be)]])
@@ -125,7 +126,8 @@ def test_notes_closed_forms():
         K.euler_rate_matrix("XYZ", [al, be, ga], frame="world"), xyz, atol=1e-15
     )
     psi, th, phi = 0.7, 0.5, -0.2  # ZYX: yaw psi, pitch theta, roll phi
-    # the notes' columns are (phi', theta', psi'); ours follow the sequence (psi, th, phi)
+    # written with columns (phi', theta', psi'), roll first, as aerospace texts do;
+    # ours follow the sequence (psi, th, phi)
     world = np.array(
         [[c(psi) * c(th), -s(psi), 0], [s(psi) * c(th), c(psi), 0], [-s(th), 0, 1]]
     )

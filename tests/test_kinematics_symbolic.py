@@ -1,5 +1,5 @@
-"""The symbolic derivations (issue 8 §7): the notes' formulas derived from the kernels,
-and each erratum of the notes' review shown (DESIGN.md).
+"""The symbolic derivations (issue 8 §7): closed forms derived from the kernels, and
+each erratum of the lecture notes listed in docs/errata.md shown (E1, E4, E6, ...).
 
 References: SymPy's own differentiation and matrix exponential of hand-written
 elementary rotations, independent of rigidkit's kernels.
@@ -55,19 +55,19 @@ phi, theta, psi = sp.symbols("phi theta psi", real=True)
 
 
 def test_euler_matrices_and_the_r_xyz_erratum():
-    """004 (2-1-1), (2-1-2): R_XYZ = Rx(phi) Ry(theta) Rz(psi) and R_ZYX. The notes'
-    R_XYZ[2, 1] reads ``c(phi) s(psi) s(theta) + s(phi) c(phi)``; the last factor is
+    """R_XYZ = Rx(phi) Ry(theta) Rz(psi) and R_ZYX, and docs/errata.md E1: a printed
+    R_XYZ[2, 1] of ``c(phi) s(psi) s(theta) + s(phi) c(phi)``, whose last factor is
     ``c(psi)``."""
     R = S.euler_matrix("XYZ", (phi, theta, psi))
     assert zero(R - Rx(phi) * Ry(theta) * Rz(psi))
     assert zero(S.euler_matrix("ZYX", (psi, theta, phi)) - Rz(psi) * Ry(theta) * Rx(phi))
     c, s = sp.cos, sp.sin
     correct = c(phi) * s(psi) * s(theta) + s(phi) * c(psi)
-    notes = c(phi) * s(psi) * s(theta) + s(phi) * c(phi)
+    printed = c(phi) * s(psi) * s(theta) + s(phi) * c(phi)
     assert sp.simplify(R[2, 1] - correct) == 0
-    assert sp.simplify(R[2, 1] - notes) != 0
-    # the notes' R_ZYX (2-1-2), entry by entry
-    notes_zyx = sp.Matrix(
+    assert sp.simplify(R[2, 1] - printed) != 0
+    # R_ZYX written out by hand, entry by entry
+    zyx_by_hand = sp.Matrix(
         [
             [c(psi) * c(theta), -s(psi) * c(phi) + c(psi) * s(theta) * s(phi),
              s(psi) * s(phi) + c(psi) * s(theta) * c(phi)],
@@ -76,7 +76,7 @@ def test_euler_matrices_and_the_r_xyz_erratum():
             [-s(theta), c(theta) * s(phi), c(theta) * c(phi)],
         ]
     )  # fmt: skip
-    assert zero(S.euler_matrix("ZYX", (psi, theta, phi)) - notes_zyx)
+    assert zero(S.euler_matrix("ZYX", (psi, theta, phi)) - zyx_by_hand)
 
 
 @pytest.mark.parametrize("seq", ["XYZ", "zxz", "yzy", "xzy"])
@@ -98,8 +98,8 @@ def test_euler_rate_matrix_is_the_derivative_of_the_rotation(seq, frame):
     assert vanishes(vee(W) - E * rates, f)
 
 
-def test_notes_rate_matrices_derived():
-    """000 D.2 (XYZ world) and 004 2.1 (ZYX world and body) with their inverses."""
+def test_rate_matrices_derived():
+    """XYZ in world axes, and ZYX in world and body axes with their inverses."""
     al, be, ga = sp.symbols("alpha beta gamma", real=True)
     c, s = sp.cos, sp.sin
     assert S.euler_rate_matrix("XYZ", (al, be, ga), frame="world") == sp.Matrix(
@@ -113,19 +113,19 @@ def test_notes_rate_matrices_derived():
     assert Eb == sp.Matrix(
         [[1, 0, -s(theta)], [0, c(phi), s(phi) * c(theta)], [0, -s(phi), c(phi) * c(theta)]]
     )
-    notes_body_inv = sp.Matrix(
+    body_inv_by_hand = sp.Matrix(
         [
             [1, s(phi) * sp.tan(theta), c(phi) * sp.tan(theta)],
             [0, c(phi), -s(phi)],
             [0, s(phi) / c(theta), c(phi) / c(theta)],
         ]
     )
-    assert zero(Eb.inv() - notes_body_inv)
+    assert zero(Eb.inv() - body_inv_by_hand)
 
 
 def test_derivative_at_zero_sign_erratum():
-    """000 E: d/dt Rx(w1 t) Ry(w2 t) Rz(w3 t) at 0 is hat(w), whose (3,1) entry is -w2
-    (the notes write +w2)."""
+    """d/dt Rx(w1 t) Ry(w2 t) Rz(w3 t) at 0 is hat(w), whose (3,1) entry is -w2, not
+    the +w2 of docs/errata.md E6."""
     w = sp.symbols("w1 w2 w3", real=True)
     R = S.euler_matrix("XYZ", tuple(wi * t for wi in w))
     D = R.diff(t).subs(t, 0)
@@ -135,7 +135,7 @@ def test_derivative_at_zero_sign_erratum():
 
 
 def test_rotational_acceleration_erratum():
-    """000 D.3: q'' = (hat(w') + hat(w)^2) q, not (hat(w) + hat(w)^2) q."""
+    """q'' = (hat(w') + hat(w)^2) q, not (hat(w) + hat(w)^2) q (docs/errata.md E3)."""
     f = [sp.Function(n, real=True)(t) for n in ("a", "b", "c")]
     R = S.euler_matrix("ZYX", f)
     rates = sp.Matrix([g.diff(t) for g in f])
@@ -150,14 +150,14 @@ def test_rotational_acceleration_erratum():
 
 
 def test_quaternion_matrix_and_the_inverse_erratum():
-    """004 2.3's matrix for unit q; for any q, q v q^-1 needs q^-1 = q*/|q|^2 (002 wrote
-    q*/|q|, which scales by |q|)."""
+    """The rotation matrix of a unit q; for any q, q v q^-1 needs q^-1 = q*/|q|^2
+    (q*/|q|, docs/errata.md E2, scales by |q|)."""
     w, x, y, z = sp.symbols("w x y z", real=True)
     R = S.quaternion_matrix((w, x, y, z))
     n2 = w**2 + x**2 + y**2 + z**2
     assert zero(R.T * R - sp.eye(3))
     assert sp.simplify(R.det() - 1) == 0
-    notes = sp.Matrix(
+    by_hand = sp.Matrix(
         [
             [1 - 2 * y**2 - 2 * z**2, 2 * x * y - 2 * w * z, 2 * w * y + 2 * x * z],
             [2 * x * y + 2 * w * z, 1 - 2 * x**2 - 2 * z**2, 2 * y * z - 2 * w * x],
@@ -165,7 +165,7 @@ def test_quaternion_matrix_and_the_inverse_erratum():
         ]
     )
     unit = {w: sp.sqrt(1 - x**2 - y**2 - z**2)}
-    assert zero((R - notes).subs(unit))
+    assert zero((R - by_hand).subs(unit))
     # with q*/|q| the conjugation is |q| R: not a rotation unless |q| = 1
     wrong = R * sp.sqrt(n2)
     assert sp.simplify((wrong.T * wrong)[0, 0] - n2) == 0
@@ -180,7 +180,7 @@ def test_quaternion_matrix_and_the_inverse_erratum():
 
 
 def test_twist_exponential_erratum():
-    """000 E (marked doubtful in the notes): exp(hat(V) t) has translation
+    """docs/errata.md E4: exp(hat(V) t) has translation
     (I - R)(w x v)/|w|^2 + w w^T v t/|w|^2, not hat(w) v (I - R)/|w|^2."""
     v = sp.symbols("v_x v_y v_z", real=True)
     w = sp.symbols("w_x w_y w_z", real=True)
@@ -202,14 +202,14 @@ def test_twist_exponential_erratum():
     n2 = wv.dot(wv)
     R = M[:3, :3]
     corrected = (sp.eye(3) - R) * (wv.cross(vv)) / n2 + wv * (wv.T * vv) * tt / n2
-    notes = (sp.eye(3) - R) * Wm * vv / n2  # hat(w) v (I - R) / |w|^2, as a vector
+    e4 = (sp.eye(3) - R) * Wm * vv / n2  # hat(w) v (I - R) / |w|^2, as a vector
     np.testing.assert_allclose(
         np.array(corrected.subs(vals).evalf(30), dtype=float).ravel(),
         ref[:3, 3],
         atol=1e-14,
     )
     assert (
-        np.abs(np.array(notes.subs(vals).evalf(30), dtype=float).ravel() - ref[:3, 3]).max()
+        np.abs(np.array(e4.subs(vals).evalf(30), dtype=float).ravel() - ref[:3, 3]).max()
         > 0.1
     )
     # points are [q; 1]: the last row is (0, 0, 0, 1)

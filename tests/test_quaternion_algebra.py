@@ -61,7 +61,7 @@ def test_table_satisfies_ijk():
 
 
 def left_ref(q):
-    """``q+ = [[s, -v^T], [v, s I + hat(v)]]`` as in the notes (002)."""
+    """``q+ = [[s, -v^T], [v, s I + hat(v)]]``, the matrix of ``p -> q p``."""
     s, (x, y, z) = q[0], q[1:]
     v = np.array([x, y, z])
     hat = np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])
@@ -71,7 +71,7 @@ def left_ref(q):
 
 
 def right_ref(q):
-    """``q(+) = [[s, -v^T], [v, s I - hat(v)]]`` as in the notes (002)."""
+    """``q(+) = [[s, -v^T], [v, s I - hat(v)]]``, the matrix of ``p -> p q``."""
     s, (x, y, z) = q[0], q[1:]
     v = np.array([x, y, z])
     hat = np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])
@@ -165,7 +165,7 @@ def test_algebra_identities(a, b, c):
 
 
 def test_product_matrices(rng):
-    """``q1 q2 == q1+ q2 == q2(+) q1``, and both matrices equal the notes' formulas."""
+    """``q1 q2 == q1+ q2 == q2(+) q1``, and both matrices equal their closed forms."""
     a = rng.standard_normal((20, 4))
     b = rng.standard_normal((20, 4))
     A, B = rk.Quaternion(a), rk.Quaternion(b)
@@ -195,7 +195,7 @@ def test_inverse(rng):
     one = np.broadcast_to([1.0, 0.0, 0.0, 0.0], q.shape)
     np.testing.assert_allclose(np.asarray(Q * Q.inv()), one, rtol=0, atol=8 * EPS)
     np.testing.assert_allclose(np.asarray(Q.inv() * Q), one, rtol=0, atol=8 * EPS)
-    # q^-1 = q* / |q|^2 (the notes' q* / |q| is wrong unless |q| = 1)
+    # q^-1 = q* / |q|^2 (q* / |q|, docs/errata.md E2, is wrong unless |q| = 1)
     ref = q * np.array([1, -1, -1, -1]) / np.sum(q * q, axis=-1, keepdims=True)
     np.testing.assert_allclose(np.asarray(Q.inv()), ref, rtol=4 * EPS, atol=0)
     wrong = q * np.array([1, -1, -1, -1]) / np.linalg.norm(q, axis=-1, keepdims=True)

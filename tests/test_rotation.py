@@ -545,7 +545,7 @@ def test_symbolic_rotational_acceleration():
     p = R * p0
     residual = p.diff(t, 2) - (W.diff(t) + W * W) * p
     assert residual.applyfunc(sp.cancel) == sp.zeros(3, 1)
-    # The notes' version without the derivative of hat(w) is wrong here.
+    # Without the derivative of hat(w) (docs/errata.md E3) it is wrong here.
     assert (p.diff(t, 2) - W * W * p).applyfunc(sp.cancel) != sp.zeros(3, 1)
 
 

@@ -3,8 +3,8 @@
 References: scipy.linalg.expm / logm of the 4x4 hat matrix, mpmath at 50+
 digits (``mp.expm``, the series ``J_l = sum_k ad^k / (k+1)!`` and the coefficient
 definitions), scipy's ``RigidTransform`` (whose exponential coordinates are
-ordered ``(w, v)``, ours ``(v, w)``), the closed forms of the notes and of
-DESIGN.md's errata written out here with NumPy. (Central finite differences check
+ordered ``(w, v)``, ours ``(v, w)``), and closed forms (Murray, Li & Sastry 1994,
+Sec. 2.3) written out here with NumPy. (Central finite differences check
 every group's Jacobians at once, in ``test_jacobians_fd.py``.)
 """
 
@@ -161,9 +161,10 @@ def test_exp_log_against_scipy_expm_logm(rng):
 
 
 def test_exp_is_the_errata_closed_form(rng):
-    """DESIGN.md errata: ``t = (I - R)(w x v)/|w|^2 + w w^T v / |w|^2``, ``R = exp(hat w)``.
+    """``t = (I - R)(w x v)/|w|^2 + w w^T v / |w|^2``, ``R = exp(hat w)``.
 
-    Written out here for ``|w|`` in [0.1, 3] (below 0.1 that form itself cancels).
+    Murray, Li & Sastry's form (1994, Sec. 2.3.2), which corrects docs/errata.md E4,
+    written out here for ``|w|`` in [0.1, 3] (below 0.1 that form itself cancels).
     """
     n = 300
     xi = twist(rng, 1.0, n) * np.concatenate(
@@ -177,7 +178,7 @@ def test_exp_is_the_errata_closed_form(rng):
     M = rk.se3.exp(xi)
     np.testing.assert_allclose(M[:, :3, 3], t, rtol=0, atol=1e-14 * 8)
     np.testing.assert_allclose(M[:, :3, :3], R, rtol=0, atol=4 * EPS)
-    # The notes' form hat(w) v (I - R) / |w|^2 is indeed different.
+    # The form hat(w) v (I - R) / |w|^2 of docs/errata.md E4 is indeed different.
     wrong = np.einsum("nij,nj->ni", np.eye(3) - R, np.cross(w, v)) / t2
     assert np.abs(M[:, :3, 3] - wrong).max() > 0.1
 
@@ -405,7 +406,7 @@ def test_against_scipy_rigid_transform(rng):
 
 
 def test_homogeneous_inverse(rng):
-    """The notes' ``G^-1 = [[R^T, -R^T p], [0, 1]]``, written out with NumPy."""
+    """``G^-1 = [[R^T, -R^T p], [0, 1]]`` (Murray, Li & Sastry 1994, Sec. 2.3.1)."""
     T = rk.Transform.random((4, 25), rng, scale=10.0)
     R = T.rotation.as_matrix()
     t = T.translation

@@ -1,8 +1,8 @@
-"""SO(3) calculus: Jacobians, their inverses, the bracket, and the notes' identities.
+"""SO(3) calculus: Jacobians, their inverses, the bracket, and the identities of hat.
 
 References: mpmath at 50 digits (the coefficient definitions and the series
 ``J_l = sum_k hat(w)^k / (k+1)!``), torch autograd through rigidkit's own torch path,
-and the identities of the notes written out with NumPy. (Central finite differences
+and the identities of the cross product written out with NumPy. (Central finite differences
 check every group's Jacobians at once, in ``test_jacobians_fd.py``.)
 
 Convention under test: ``exp(w + d) ~ exp(J_l d) exp(w) ~ exp(w) exp(J_r d)``.
@@ -189,7 +189,7 @@ def test_right_jacobian_by_torch_autograd(torch, rng):
         np.testing.assert_allclose(qw * dq[0] + qv @ dq[1:], 0.0, atol=1e-15)
 
 
-# -- the notes' identities -------------------------------------------------------------
+# -- identities of the cross product and hat --------------------------------------------
 
 
 vec = st.lists(st.floats(-10, 10, allow_nan=False), min_size=3, max_size=3).map(np.array)
@@ -217,7 +217,7 @@ def test_jacobi_identity_and_double_cross_product(a, b, c):
 
 
 def test_conjugated_hat_and_hat_squared(rng):
-    """``(R w)^ = R hat(w) R^T`` and ``hat(w)^2 = w w^T - |w|^2 I`` (notes, section D)."""
+    """``(R w)^ = R hat(w) R^T`` and ``hat(w)^2 = w w^T - |w|^2 I``."""
     w = rng.standard_normal((200, 3)) * 3.0
     R = SciRot.random(200, random_state=1).as_matrix()
     Rw = np.einsum("nij,nj->ni", R, w)

@@ -167,7 +167,8 @@ def euler_rate_matrix(seq, symbols=None, *, frame=None):
 
     Examples
     --------
-    The notes' ZYX body matrix (004 2.1), columns ``(phi', theta', psi')`` there:
+    The body matrix of intrinsic ``"ZYX"`` (yaw ``psi``, pitch ``theta``, roll
+    ``phi``), its columns reordered to ``(phi', theta', psi')``:
 
     >>> import sympy as sp
     >>> phi, theta, psi = sp.symbols("phi theta psi", real=True)
@@ -190,7 +191,8 @@ def quaternion_matrix(symbols=None):
 
     ``q^-1 = q* / |q|^2``, so this is the rotation matrix of ``q / |q|`` for any
     scale: ``(1/|q|^2) [[w^2 + x^2 - y^2 - z^2, 2(xy - wz), 2(xz + wy)], ...]``,
-    which for a unit quaternion is the notes' matrix (004 2.3). Built from the
+    which for a unit quaternion is the usual ``[[1 - 2(y^2 + z^2), ...]]``.
+    Built from the
     kernels ``quat_multiply`` and ``quat_conjugate``.
 
     Parameters
@@ -223,7 +225,7 @@ def twist_exp(symbols=None, t=None):
     From the kernels ``pose_from_twist`` (applied to ``V t``) and
     ``matrix_from_pose``; the rotation block is Rodrigues' formula, the
     translation ``(I - R)(omega x v)/|omega|^2 + omega omega^T v t / |omega|^2``
-    (the notes' ``hat(omega) v (I - R)/|omega|^2``, marked doubtful there, is wrong).
+    (Murray, Li & Sastry 1994, Sec. 2.3.2, with ``omega`` not normalised).
 
     Parameters
     ----------

@@ -1,7 +1,7 @@
 """What the functional modules of the groups share: the vocabulary and the right Jacobians.
 
 Every group module (``so3``, ``se3``, ``so2``, ``se2``, ``sim3``) offers the same Lie
-vocabulary, :data:`VOCABULARY` (STYLE.md: one name per concept). Of the four
+vocabulary, :data:`VOCABULARY` (one name per concept in every group). Of the four
 Jacobians a module writes only the left one and its inverse (kernels, with their
 formulas and series); the right ones are derived here, once for all groups:
 

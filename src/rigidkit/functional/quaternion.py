@@ -76,8 +76,8 @@ def norm(q):
 def inv(q):
     """Multiplicative inverse ``q^-1 = q* / |q|^2``, shape (..., 4).
 
-    (The notes write ``q* / |q|``, which is wrong unless ``|q| = 1``.)
-    ``q q^-1 = q^-1 q = 1``.
+    ``q q* = |q|^2``, so ``q q^-1 = q^-1 q = 1``; for a unit quaternion the inverse
+    is the conjugate.
 
     Raises
     ------

@@ -2,7 +2,8 @@
 
 Chasles' theorem: every rigid motion is a turn by ``angle`` about an axis (a point
 ``q`` on it and a direction ``u``) combined with a slide of ``pitch * angle`` along
-it. For a twist ``V = (v, w)`` (the notes' order): ``u = w / |w|``, magnitude
+it. For a twist ``V = (v, w)`` (Murray, Li & Sastry 1994, Sec. 2.3.3, whose
+twists are ordered so too): ``u = w / |w|``, magnitude
 ``|w|``, pitch ``h = w . v / |w|^2`` (length per radian) and ``q = w x v / |w|^2``,
 the axis point nearest the origin; ``v = -w x q + h w``. A twist with ``w = 0`` is
 a pure translation: pitch ``inf``, ``u = v / |v|``, magnitude ``|v|``, ``q = 0``.

@@ -1,6 +1,6 @@
 """Arrays handed out by an object never alias its storage.
 
-Objects are immutable values (DESIGN.md): writing into an array that a method or
+Objects are immutable values: writing into an array that a method or
 property returned must not change the object. Accessors that would return the
 stored array itself, or a slice of it (``Rotation.as_quat``, ``Transform.translation``,
 ``Quaternion.w``, ``Projective.as_matrix``, ...), pass it through :func:`frozen`;

@@ -116,7 +116,8 @@ class Group(ABC):
             other = type(self).include(other)  # out= has the stored shape of self's kind
         return self._wrap(self._compose_kernel(self._data, other._data, out=out))
 
-    # ``*`` has no meaning here (STYLE.md: one operator, one meaning); scipy users
+    # ``*`` has no meaning here (one operator, one meaning: ``@`` composes or acts,
+    # docs/architecture.md); scipy users
     # write ``R1 * R2`` for what is ``R1 @ R2`` in rigidkit, so the error says so.
     def __mul__(self, other):
         raise TypeError(_no_mul(self, other))

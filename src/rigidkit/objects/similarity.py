@@ -3,7 +3,7 @@
 A rotation, a translation and a uniform scale ``s > 0``; homogeneous matrix
 ``[[s R, t], [0, 1]]``. Twists are ordered ``(v, omega, sigma)`` with ``sigma =
 log s``: ``hat(xi) = [[hat(omega) + sigma I, v], [0, 0]]``, extending the SE(3)
-order ``(v, omega)`` of the notes. Quaternions are Hamilton, scalar first.
+order ``(v, omega)`` (docs/conventions.md). Quaternions are Hamilton, scalar first.
 
 Storage: one array of shape (..., 8), ``(w, x, y, z, tx, ty, tz, s)``. We store the
 scale itself rather than ``log s``: a scale given by the user reads back exactly

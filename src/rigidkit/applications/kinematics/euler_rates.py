@@ -79,8 +79,9 @@ def euler_rate_matrix(seq, angles, *, frame=None, degrees=False):
 
     Examples
     --------
-    The notes' XYZ space-frame matrix (000 D.2), ``[[1, 0, sb], [0, ca, -sa cb],
-    [0, sa, ca cb]]``:
+    Intrinsic ``"XYZ"`` (``R = Rx(a) Ry(b) Rz(c)``) in world axes: the columns are
+    the axes the three rates turn about, ``x``, ``Rx(a) y`` and ``Rx(a) Ry(b) z``,
+    so ``E = [[1, 0, sb], [0, ca, -sa cb], [0, sa, ca cb]]``:
 
     >>> import numpy as np
     >>> a, b = 0.3, 0.4

@@ -1,7 +1,7 @@
 """Planar kinematics: SO(2) and SE(2) velocities and points moving in the plane.
 
-A planar rotation ``R(t) = exp(theta(t) J)``, ``J = [[0, -1], [1, 0]]`` (the
-notes' ``e^{J omega t}``: the additive property ``F(t) F(s) = F(t + s)`` makes
+A planar rotation ``R(t) = exp(theta(t) J)``, ``J = [[0, -1], [1, 0]]`` (a
+constant rate makes a one-parameter group, ``F(t) F(s) = F(t + s)``, which is
 ``R = exp(omega J t)`` with ``omega J = R'(0)``), turns at ``omega`` with
 ``R' = omega J R = R omega J``: world and body angular velocity are one number
 (shape (..., 1), like the so(2) tangent vectors). Planar twists are
@@ -94,7 +94,7 @@ def rotation_derivative(R, omega, *, frame=None):
 
     Examples
     --------
-    The notes' ``R'(0) = omega J``:
+    At the identity, ``R' = omega J``:
 
     >>> import numpy as np
     >>> rotation_derivative(np.eye(2), [2.0], frame="world") + 0.0
@@ -229,9 +229,8 @@ def point_acceleration(
     """``a = a_O + (alpha J - omega^2 I) r + 2 omega J v_rel + a_rel``.
 
     ``alpha J r`` tangential, ``-omega^2 r`` centripetal, ``2 omega J v_rel``
-    Coriolis; for a point of the body this is the notes' planar
-    ``[[-omega^2, -alpha], [alpha, -omega^2]] r`` (000 D.3, with ``alpha`` for the
-    derivative they write ``omega'``).
+    Coriolis; for a point of the body (``v_rel = a_rel = 0``) it is
+    ``[[-omega^2, -alpha], [alpha, -omega^2]] r`` with ``alpha = omega'``.
 
     Parameters
     ----------

@@ -4,8 +4,9 @@ Conventions: ``R = A_R_B`` maps body (``B``) coordinates to world (``A``)
 coordinates, ``v_A = A_R_B @ v_B``. The world angular velocity has
 ``R' = hat(omega_A) R``, the body one ``R' = R hat(omega_B)``, and
 ``omega_A = R omega_B``. For the inverse, ``B_R_A = R^T``: ``(B_R_A)' =
--B_R_A hat(omega_A) = -hat(omega_B) B_R_A`` (the four forms of the notes, 004
-1.4; pass ``R.inv()`` and negate, or use them as written). Quaternions are
+-B_R_A hat(omega_A) = -hat(omega_B) B_R_A`` (the spatial and body angular
+velocities of Murray, Li & Sastry 1994, Sec. 2.4.1, and their forms for the
+inverse; pass ``R.inv()`` and negate, or use them as written). Quaternions are
 Hamilton, scalar first: ``q' = q (0, omega_B) / 2 = (0, omega_A) q / 2``.
 """
 
@@ -135,8 +136,9 @@ def angular_acceleration(R, R_dot, R_ddot, *, frame=None):
 def rotation_second_derivative(R, omega, alpha, *, frame=None):
     """``R'' = (hat(alpha) + hat(omega)^2) R`` (world) or ``R (hat(alpha) + hat(omega)^2)``.
 
-    The matrix form of the rotational acceleration (notes 000 D.3, whose
-    ``hat(omega) + hat(omega)^2`` drops the derivative of the first term).
+    The matrix form of the rotational acceleration: differentiate
+    ``R' = hat(omega) R`` once more (docs/errata.md E3 lists a form that drops the
+    derivative of ``hat(omega)``).
 
     Parameters
     ----------

@@ -2,14 +2,15 @@
 
 Conventions: ``T = W_T_B = [[R, p], [0, 1]]`` maps body points to world points;
 twists are ``V = (v, omega)`` with ``hat(V) = [[hat(omega), v], [0, 0]]`` (scipy
-orders them ``(omega, v)``). The world twist (``hat(V) = T' T^-1``, the notes'
-spatial velocity) has ``v = p' - omega x p``, the velocity of the world point
-passing through the origin; the body twist (``T^-1 T'``) has ``v = R^T p'``, the
-velocity of the body origin in body axes. ``V_world = Ad_T V_body``.
+orders them ``(omega, v)``). The world twist (``hat(V) = T' T^-1``, the spatial
+velocity of Murray, Li & Sastry 1994, Sec. 2.4.2) has ``v = p' - omega x p``, the
+velocity of the world point passing through the origin; the body twist
+(``T^-1 T'``, their body velocity) has ``v = R^T p'``, the velocity of the body
+origin in body axes. ``V_world = Ad_T V_body``.
 
 A point ``q`` of the body (world coordinates) moves at ``hat(V) [q; 1]`` and
-accelerates at ``(hat(V') + hat(V)^2) [q; 1]`` (world twists; the notes'
-``hat(V) + hat(V)^2`` on ``[q; 0]`` is corrected on both counts).
+accelerates at ``(hat(V') + hat(V)^2) [q; 1]`` (world twists: differentiate
+``[q'; 0] = hat(V) [q; 1]`` once more).
 """
 
 from __future__ import annotations
@@ -38,7 +39,8 @@ twist_from_screw = _screw.twist_from_screw
 def twist_from_derivative(T, T_dot, *, frame=None):
     """Twist ``(v, omega)`` of a moving frame: ``hat(V) = T' T^-1`` or ``T^-1 T'``.
 
-    World: ``omega = vee(R' R^T)``, ``v = p' - omega x p`` (notes 000 E.1); body:
+    World: ``omega = vee(R' R^T)``, ``v = p' - omega x p`` (the spatial velocity of
+    Murray, Li & Sastry 1994, Sec. 2.4.2); body:
     ``omega = vee(R^T R')``, ``v = R^T p'``.
 
     Parameters
@@ -138,9 +140,10 @@ def spatial_acceleration_matrix(twist, twist_dot, *, frame=None):
 
     For world twists, ``q'' = M [q; 1]`` is the acceleration of the body point at
     world position ``q`` (``M = T'' T^-1``); for body twists ``M = T^-1 T''`` acts
-    on body coordinates and gives the acceleration in body axes. The notes write
-    ``hat(V) + hat(V)^2`` on ``[q; 0]``: the first term is the derivative of the
-    twist, and points are ``[q; 1]``.
+    on body coordinates and gives the acceleration in body axes. Differentiating
+    ``[q'; 0] = hat(V) [q; 1]`` gives ``[q''; 0] = hat(V') [q; 1] + hat(V) [q'; 0] =
+    (hat(V') + hat(V)^2) [q; 1]``: the derivative of the twist, acting on the point
+    ``[q; 1]``.
 
     Parameters
     ----------
