@@ -120,7 +120,7 @@ def kitti_errors(ref, est, lengths=LENGTHS, step=10):
     if len(first) == 0:
         raise ShapeError(
             f"no segment: the ground truth is {dist[-1]:.6g} m long, shorter than "
-            f"the shortest length {min(lengths)!r} m"
+            f"the shortest length {float(min(lengths))!r} m"
         )
     R, P = ref.poses, est.poses
     E = (P[first].inv() @ P[last]).inv() @ (R[first].inv() @ R[last])
