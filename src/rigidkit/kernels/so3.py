@@ -25,7 +25,7 @@ translation of the exp of a twist is ``J_l(w) v``).
 Rates of a rotation-vector curve: for ``R(t) = R0 exp(hat(r(t)))`` the body angular
 velocity (``R^T dR/dt = hat(omega)``) is ``omega = J_r(r) r'`` with ``J_r(r) = I -
 a hat(r) + b hat(r)^2``, ``a = (1 - cos t)/t^2`` (versinc2), ``b = (t - sin t)/t^3``
-(sin_defect3), ``t = |r|``. Its derivative is
+(sin_defect3), ``t = |r|``. Its derivative is::
 
     omega' = J_r(r) r'' + (dJ_r/dt) r'
            = J_r(r) r'' + (r.r') (k1 r x r' + k2 r x (r x r')) + b r' x (r x r')
