@@ -79,3 +79,21 @@ def test_each_public_module_has_one_import_path():
         else:
             raise AssertionError(f"rigidkit.{name} is importable")
         assert f"rigidkit.{name}" not in sys.modules
+
+
+def test_the_project_cites_no_document_it_does_not_hold():
+    """No source or test cites the lecture notes as if the reader had them, nor the
+    design documents that are not in the repository: docs/errata.md holds their
+    errata, and docstrings cite published sources."""
+    root = README.parent
+    # Spelled in pieces so that this file does not match itself.
+    banned = ["the " + "notes", "notes" + "'", "DESIGN" + ".md", "STYLE" + ".md"]
+    found = [
+        f"{path.relative_to(root)}:{n}: {line.strip()}"
+        for folder in ("src", "tests")
+        for path in sorted((root / folder).rglob("*.py"))
+        for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1)
+        if any(word in line for word in banned)
+    ]
+    assert found == []
+    assert (root / "docs" / "errata.md").is_file()
