@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import rigidkit as rk
-from rigidkit.applications.io._parse import parse_table
+from rigidkit.applications.io._parse import _parse_python, parse_table
 
 read, write = rk.io.read_trajectory, rk.io.write_trajectory
 
@@ -230,7 +230,15 @@ def test_write_needs_stamps_and_is_whole(tmp_path):
 # -- the parser itself ---------------------------------------------------------------
 
 
-def test_parser_equals_python_float_on_every_token():
+_ENGINES = {
+    "numba": lambda *a: parse_table(*a, engine="numba"),
+    "numpy": lambda *a: parse_table(*a, engine="numpy"),
+    "python": _parse_python,
+}
+
+
+@pytest.mark.parametrize("engine", list(_ENGINES))
+def test_parser_equals_python_float_on_every_token(engine):
     # Tokens on and off the fast path: long mantissas, large exponents,
     # subnormals, signs, no leading digit, inf and nan.
     rng = np.random.default_rng(3)
@@ -244,11 +252,13 @@ def test_parser_equals_python_float_on_every_token():
         [repr(float(v)) for v in x]
         + [f"{v:.6f}" for v in x[:50]]
         + [f"{v:.25e}" for v in x[:50]]
+        + [f"{v:.12f}" for v in x[:50]]
         + ["+.5", "-7.", "1E5", "1e-400", "123456789012345678901234567890", "inf", "-inf"]
+        + ["1305031102.175304000", "0.500000000", "0.000000000001234", "-0.0000"]
     )
     tokens += ["0"] * (-len(tokens) % 4)
     text = "\n".join(" ".join(tokens[k : k + 4]) for k in range(0, len(tokens), 4))
-    data, lines, status, _, _ = parse_table(text.encode(), 4, True, None)
+    data, lines, status, _, _ = _ENGINES[engine](text.encode(), 4, True, None)
     assert status == "ok"
     expected = np.array([float(t) for t in tokens]).reshape(-1, 4)
     assert np.array_equal(data, expected) and lines.tolist() == list(
@@ -257,14 +267,19 @@ def test_parser_equals_python_float_on_every_token():
     assert np.array_equal(np.signbit(data), np.signbit(expected))
 
 
-def test_parser_reports_the_first_problem():
-    assert parse_table(b"1 2 3\n4 5\n", 3, True, None)[2:] == ("count", 2, 2)
-    assert parse_table(b"1 2 3\n4 x 6\n", 3, True, None)[2:] == ("token", 2, 2)
-    assert parse_table(b"1,2,3\n4,,5\n", 3, True, ",")[2:] == ("token", 2, 2)
-    assert parse_table(b"1,2,3,\n", 3, True, ",")[2:] == ("token", 1, 4)
-    assert parse_table(b"1 2 3x\n", 3, True, None)[2:] == ("token", 1, 3)
+@pytest.mark.parametrize("engine", list(_ENGINES))
+def test_parser_reports_the_first_problem(engine):
+    parse = _ENGINES[engine]
+    assert parse(b"1 2 3\n4 5\n", 3, True, None)[2:] == ("count", 2, 2)
+    assert parse(b"1 2 3\n4 x 6\n", 3, True, None)[2:] == ("token", 2, 2)
+    assert parse(b"1,2,3\n4,,5\n", 3, True, ",")[2:] == ("token", 2, 2)
+    assert parse(b"1,2,3,\n", 3, True, ",")[2:] == ("token", 1, 4)
+    assert parse(b"1 2 3x\n", 3, True, None)[2:] == ("token", 1, 3)
+    # The rows before the problem, with their lines.
+    data, lines, *_ = parse(b"# c\n1 2 3\n\n4 5 6\n7 8\n", 3, True, None)
+    assert data.tolist() == [[1, 2, 3], [4, 5, 6]] and lines.tolist() == [2, 4]
     # Not exact: further fields are ignored, even words.
-    data, *_ = parse_table(b"1,2,3,a\n", 3, False, ",")
+    data, *_ = parse(b"1,2,3,a\n", 3, False, ",")
     assert data.tolist() == [[1.0, 2.0, 3.0]]
 
 

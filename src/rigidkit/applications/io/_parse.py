@@ -1,11 +1,11 @@
 """A one-pass parser of numeric text tables, compiled with numba.
 
-``np.loadtxt`` costs ~0.5 us a line (0.5 s for a million-pose TUM file) and
-keeps no line numbers; this loop reads the bytes once, ~0.05 us a line, and
-records the file line of every row, so that a later check (a zero quaternion,
-a stamp going backwards) names its line without a second pass.
+``np.loadtxt`` costs ~0.5 us a line of a TUM file (0.5 s for a million poses)
+and keeps no line numbers; this loop reads the bytes once, in about a third of
+that CPU time, and records the file line of every row, so that a later check (a
+zero quaternion, a stamp going backwards) names its line without a second pass.
 
-Numbers are converted exactly: a decimal with at most 19 significant digits whose
+Numbers are converted exactly: a decimal with at most 18 significant digits whose
 integer mantissa ``m`` is below 2^53 and whose power of ten ``e`` has ``|e| <=
 22`` is ``m * 10^e`` or ``m / 10^-e``, one correctly rounded operation on two
 exact doubles (Clinger 1990, "How to read floating point numbers accurately",
@@ -18,13 +18,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..._engine import compile_host_loop, in_background, numba_available
+
 __all__ = ["parse_table"]
 
 # Status codes of the loop.
 OK, BAD_COUNT, BAD_TOKEN = 0, 1, 2
 
 _POW10 = np.array([10.0**k for k in range(23)])
-_compiled = None
+_JOB = None
 
 
 def _loop(buf, ncols, exact, delim, pow10, out, lines, slow):
@@ -102,6 +104,7 @@ def _loop(buf, ncols, exact, delim, pow10, out, lines, slow):
                 drop += 1
                 inexact = True
             pos += 1
+        tz = 0  # trailing zeros of the fraction kept in mant ("0.500000000")
         if pos < n and buf[pos] == 46:
             pos += 1
             while pos < n:
@@ -114,9 +117,15 @@ def _loop(buf, ncols, exact, delim, pow10, out, lines, slow):
                         ndig += 1
                     mant = mant * 10 + d
                     frac += 1
+                    tz = tz + 1 if d == 0 else 0
                 elif d != 0:
                     inexact = True
                 pos += 1
+            if mant >= 9007199254740992:
+                while tz > 0:  # exact: they are zeros
+                    mant //= 10
+                    frac -= 1
+                    tz -= 1
         exp = 0
         good = seen > 0
         if good and pos < n and (buf[pos] == 101 or buf[pos] == 69):
@@ -170,16 +179,31 @@ def _loop(buf, ncols, exact, delim, pow10, out, lines, slow):
     return OK, row, line, 0, nslow
 
 
-def _compile():
-    global _compiled
-    if _compiled is None:
-        import numba
+def _build():
+    """The compiled loop (on the engine's background thread)."""
+    return compile_host_loop(
+        _loop,
+        ("r1:uint8", "int", "bool", "int", "r1", "w2", "w1:int64", "w2:int64"),
+        dtypes=("float64",),
+        returns=("int", "int", "int", "int", "int"),
+    )
 
-        _compiled = numba.njit(cache=True, nogil=True)(_loop)
-    return _compiled
+
+def _job():
+    """The loop's build, queued on first use; None without numba."""
+    global _JOB
+    if _JOB is None and numba_available():
+        _JOB = in_background("rigidkit.io text tables", _build)
+    return _JOB
 
 
-def parse_table(data: bytes, ncols: int, exact: bool, delimiter):
+def loop_ready() -> bool:
+    """Whether the compiled loop is ready (asking starts its build)."""
+    job = _job()
+    return job is not None and job.done.is_set() and job.error is None
+
+
+def parse_table(data: bytes, ncols: int, exact: bool, delimiter, engine="auto"):
     """Parse ``data`` into ``(values, lines, status, line, field)``.
 
     ``values`` (rows, ncols) float64 and ``lines`` (rows,) the 1-based file
@@ -189,15 +213,35 @@ def parse_table(data: bytes, ncols: int, exact: bool, delimiter):
     start with ``#`` are skipped, and ``#`` ends a line's data. Only the first
     ``ncols`` fields are read; with ``exact`` a line must have exactly that many.
     ``delimiter``: ``None`` for runs of spaces and tabs, else one character.
+    ``engine``: ``"numba"`` (this module's loop, waiting for its build),
+    ``"numpy"`` (``np.loadtxt``; a failure is diagnosed by the loop, or by a
+    line-by-line scan without numba) or ``"auto"``: the loop once the engine's
+    background thread has built it (the first use queues the build: loading
+    numba costs a process ~1 s, more than ``np.loadtxt`` spends on a
+    million lines), ``np.loadtxt`` until then. All give the same values.
     """
+    if engine == "auto":
+        engine = "numba" if loop_ready() else "numpy"
+    if engine == "numpy":
+        parsed = _parse_numpy(data, ncols, exact, delimiter)
+        if parsed is not None:
+            return parsed
+        if _job() is None:
+            return _parse_python(data, ncols, exact, delimiter)
     buf = np.frombuffer(data, dtype=np.uint8)
-    rows = data.count(b"\n") + 1
+    # A row takes at least 2 ncols bytes ("1 2 3\n"): a bound on the rows that
+    # costs no pass over the data (np.empty's untouched pages cost nothing).
+    rows = (len(data) + 1) // (2 * ncols) + 1
     out = np.empty((rows, ncols))
     lines = np.empty(rows, dtype=np.int64)
-    # Tokens off the fast path are rare; a file full of them is parsed twice.
-    slow = np.empty((min(rows * ncols, 4096), 5), dtype=np.int64)
+    # Tokens off the fast path are rare in files written with up to 16 digits; a
+    # file full of them (17-digit round-trip output) is parsed twice.
+    slow = np.empty((min(rows * ncols, max(4096, rows * ncols // 16)), 5), dtype=np.int64)
     delim = 0 if delimiter is None else ord(delimiter)
-    loop = _compile()
+    job = _job()
+    if job is None:
+        return _parse_python(data, ncols, exact, delimiter)
+    loop = job.result()
     while True:
         status, nrows, line, field, nslow = loop(
             buf, ncols, exact, delim, _POW10, out, lines, slow
@@ -205,11 +249,10 @@ def parse_table(data: bytes, ncols: int, exact: bool, delimiter):
         if nslow <= len(slow):
             break
         slow = np.empty((nslow, 5), dtype=np.int64)
-    for r, c, a, b, ln in slow[:nslow].tolist():
-        token = data[a:b].decode("utf-8", "replace")
-        try:
-            out[r, c] = float(token)
-        except ValueError:
+    if nslow:
+        bad = _convert_slow(buf, data, slow[:nslow], out)
+        if bad is not None:
+            r, c, ln = bad
             if status == OK or ln < line or (ln == line and c + 1 < field):
                 return out[:r], lines[:r], "token", ln, c + 1
     if status != OK:
@@ -221,3 +264,94 @@ def parse_table(data: bytes, ncols: int, exact: bool, delimiter):
             field,
         )
     return out[:nrows], lines[:nrows], "ok", 0, 0
+
+
+def _convert_slow(buf, data, slow, out):
+    """Convert the tokens off the fast path into ``out``; the first that is not a
+    number as ``(row, col, line)``, else None.
+
+    NumPy's cast of byte strings to float64 (correctly rounded, as ``float``)
+    converts them all at once; a token it rejects is looked for one by one.
+    """
+    start, end = slow[:, 2], slow[:, 3]
+    width = int((end - start).max())
+    if 0 < width <= 64:
+        k = np.arange(width)
+        idx = np.minimum(start[:, None] + k, len(buf) - 1)
+        chars = np.where(k < (end - start)[:, None], buf[idx], 0).astype(np.uint8)
+        try:
+            values = np.ascontiguousarray(chars).view(f"S{width}")[:, 0].astype(np.float64)
+        except ValueError:
+            pass
+        else:
+            out[slow[:, 0], slow[:, 1]] = values
+            return None
+    for r, c, a, b, ln in slow.tolist():
+        try:
+            out[r, c] = float(data[a:b].decode("utf-8", "replace"))
+        except ValueError:
+            return r, c, ln
+    return None
+
+
+def _parse_numpy(data, ncols, exact, delimiter):
+    """:func:`parse_table` by ``np.loadtxt``; None where it fails (then the loop
+    finds what is wrong)."""
+    import warnings
+
+    lines = data.decode("utf-8", "replace").splitlines()
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # "input contained no data"
+            values = np.loadtxt(
+                lines,
+                delimiter=delimiter,
+                comments="#",
+                ndmin=2,
+                dtype=np.float64,
+                usecols=None if exact else range(ncols),
+            )
+    except ValueError:
+        return None
+    numbers = np.array(
+        [n for n, line in enumerate(lines, start=1) if line.strip()[:1] not in ("", "#")],
+        dtype=np.int64,
+    )
+    if values.size == 0:
+        values = np.zeros((0, ncols))
+    if values.shape != (len(numbers), ncols):
+        return None
+    return values, numbers, "ok", 0, 0
+
+
+def _parse_python(data, ncols, exact, delimiter):
+    """:func:`parse_table` line by line in Python (without numba): the same rules."""
+    values, numbers = [], []
+    for n, raw in enumerate(data.decode("utf-8", "replace").splitlines(), start=1):
+        text = raw.split("#", 1)[0]
+        if not text.strip():
+            continue
+        if delimiter is None:
+            fields = text.split()
+        else:
+            fields = [f.strip() for f in text.split(delimiter)]
+        row = []
+        for k, field in enumerate(fields):
+            if k >= ncols:  # not read; only an empty field is an error
+                if not field:
+                    return _done(values, numbers, ncols, "token", n, k + 1)
+                continue
+            try:
+                row.append(float(field))
+            except ValueError:
+                return _done(values, numbers, ncols, "token", n, k + 1)
+        if len(fields) < ncols or (exact and len(fields) != ncols):
+            return _done(values, numbers, ncols, "count", n, len(fields))
+        values.append(row)
+        numbers.append(n)
+    return _done(values, numbers, ncols, "ok", 0, 0)
+
+
+def _done(values, numbers, ncols, status, line, field):
+    out = np.array(values, dtype=np.float64).reshape(len(values), ncols)
+    return out, np.array(numbers, dtype=np.int64), status, line, field
