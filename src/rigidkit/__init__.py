@@ -8,12 +8,15 @@ Euler UPPER = intrinsic, lower = extrinsic; twists ``(v, omega)``; radians unles
 
 from ._validate import set_validation
 from .errors import (  # noqa: F401  (exported below as listed in errors.__all__)
+    ConnectivityError,
     ConvergenceWarning,
     DegenerateInputError,
     EulerSequenceError,
+    ExtrapolationError,
     FrameKeywordError,
     GimbalLockError,
     GimbalLockWarning,
+    LookupError,
     NonFiniteError,
     NotAffineError,
     NotARigidTransformError,
@@ -67,6 +70,8 @@ _LAZY = {
     "Trajectory": ("applications.trajectory", "Trajectory"),
     "trajectory": ("applications.trajectory", None),
     "io": ("applications.io", None),
+    "FrameGraph": ("applications.frames", "FrameGraph"),
+    "UncertainTransform": ("applications.frames", "UncertainTransform"),
 }
 
 __version__ = "0.1.0"
@@ -98,6 +103,9 @@ __all__ = [
     "Trajectory",
     "trajectory",
     "io",
+    # frame graphs and uncertain poses
+    "FrameGraph",
+    "UncertainTransform",
     # functional layers
     "conversions",
     "euler",

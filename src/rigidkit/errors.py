@@ -24,6 +24,9 @@ __all__ = [
     "TrajectoryFileError",
     "GimbalLockError",
     "FrameKeywordError",
+    "ExtrapolationError",
+    "ConnectivityError",
+    "LookupError",
     "GimbalLockWarning",
     "ConvergenceWarning",
 ]
@@ -222,3 +225,51 @@ class TrajectoryFileError(RigidkitError):
 
 def _rebuild_file_error(cls, message, path, line, index):
     return cls(message, path=path, line=line, index=index)
+
+
+class ExtrapolationError(RigidkitError):
+    """A frame lookup asked for a time outside the data of a dynamic edge.
+
+    The message names the edge (``parent -> child``), its stamp range and the
+    requested time; ``edge`` holds ``(parent, child)``, ``range`` the
+    ``(first, last)`` stamps and ``direction`` is ``"past"`` (before the first
+    sample) or ``"future"`` (after the last), so that a program can wait for data
+    in the future and give up on the past.
+
+    >>> err = ExtrapolationError("odom -> base: 5.0 is after [0.0, 4.0]",
+    ...                          edge=("odom", "base"), range=(0.0, 4.0),
+    ...                          direction="future")
+    >>> err.direction, isinstance(err, ValueError)
+    ('future', True)
+    """
+
+    def __init__(self, message="", *, index=None, edge=None, range=None, direction=None):
+        super().__init__(message, index=index)
+        self.edge = edge
+        self.range = range
+        self.direction = direction
+
+    def __reduce__(self):
+        return (
+            _rebuild_extrapolation_error,
+            (type(self), str(self), self.index, self.edge, self.range, self.direction),
+        )
+
+
+def _rebuild_extrapolation_error(cls, message, index, edge, range, direction):
+    return cls(message, index=index, edge=edge, range=range, direction=direction)
+
+
+class ConnectivityError(RigidkitError):
+    """Two frames of a frame graph lie in different trees, so no transform links
+    them; the message names the root of each tree."""
+
+
+class LookupError(RigidkitError):  # shadows the builtin on purpose: rk.LookupError
+    """A frame name that the frame graph does not hold; the message lists the
+    closest names. A :class:`ValueError`, unlike Python's builtin ``LookupError``.
+
+    >>> import builtins
+    >>> issubclass(LookupError, ValueError), LookupError is builtins.LookupError
+    (True, False)
+    """

@@ -14,9 +14,14 @@ compile code themselves (``tests/test_layers.py`` checks):
   sequential scan of a chain kernel) or :func:`compile_host_loop` (a function in
   numba's subset); :func:`run_split` splits a call over the idle cores, and
   :func:`numba_available` says whether any of this can happen;
+* shared state: :class:`Lock` (``threading.Lock``), for the layers above that
+  guard data read and written from several threads (``rk.FrameGraph``); they
+  start no threads themselves;
 * the install step: :func:`precompile` (kernels' loops into the disk cache,
   :func:`cache_dir`) and :func:`waiting_for_loops` (every batch compiles).
 """
+
+from threading import Lock  # for the layers above, which import no threading
 
 from .binding import rebind
 from .host_loops import compile_host_loop, compile_scan, idle_workers, run_split
@@ -29,6 +34,7 @@ from .owned import owned_function
 __all__ = [
     "Helper",
     "Kernel",
+    "Lock",
     "cache_dir",
     "compile_host_loop",
     "compile_scan",

@@ -1,0 +1,317 @@
+"""The samples of one edge of a :class:`~rigidkit.FrameGraph`, and their interpolation.
+
+An edge ``parent -> child`` holds ``parent_T_child``: one pose (a static edge) or a
+time-ordered buffer of stamped poses (a dynamic edge). The buffer is written by
+one thread at a time (the graph's lock) and read by any number of threads without
+it: a reader takes a :class:`Snapshot` (views of the arrays) under the lock and
+computes outside it. That is safe because the stored samples are never written in
+place: a new newest sample goes into spare capacity past the end of every
+snapshot, dropping old samples only moves the start, and anything else (an
+out-of-order sample, a repeated stamp, a full buffer) builds new arrays.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...errors import ExtrapolationError, ShapeError, TimestampError
+from ...objects import registry
+from ...objects.transform import Transform
+from ..interpolation import slerp
+
+__all__ = ["EdgeBuffer", "Snapshot", "as_samples", "wrap_pq"]
+
+#: Rows ``(w, x, y, z, tx, ty, tz)`` (a Transform's stored layout; called ``pq``
+#: in this package) as a ``Transform`` without re-validation:
+#: every stored row went through ``Transform.from_pq`` (normalised) on insertion.
+wrap_pq = registry.spec(Transform).wrap
+
+_EXTRAPOLATE = (None, "clamp", "hold")
+_INTERPOLATION = ("decoupled", "screw")
+
+
+def as_samples(parent_T_child, stamps, cov):
+    """``(stamps, pq, cov)`` as float64 arrays ``(M,)``, ``(M, 7)``, ``(M, 6, 6)`` or None.
+
+    ``parent_T_child`` is a :class:`~rigidkit.Transform` (shape ``()`` or
+    ``(M,)``), a :class:`~rigidkit.Trajectory` (its own stamps unless ``stamps``
+    is given) or an array of ``(M, 7)`` pq rows ``(tx, ty, tz, w, x, y, z)``
+    (:meth:`~rigidkit.Transform.from_pq`). ``stamps=None`` means static (one pose,
+    ``stamps`` returned as None). The poses are returned in the stored layout of
+    a ``Transform``, rows ``(w, x, y, z, tx, ty, tz)``.
+    """
+    from ..trajectory import Trajectory  # a sibling application, loaded on use
+
+    if isinstance(parent_T_child, Trajectory):
+        if stamps is None:
+            stamps = parent_T_child.stamps
+            if stamps is None:
+                raise TimestampError("a Trajectory without stamps needs stamps=")
+        parent_T_child = parent_T_child.poses
+    if not isinstance(parent_T_child, Transform):
+        parent_T_child = Transform.from_pq(np.asarray(parent_T_child, dtype=np.float64))
+    pq = np.asarray(registry.stored(parent_T_child), dtype=np.float64)
+    if stamps is None:
+        if pq.shape != (7,):
+            raise ShapeError(
+                f"a static edge takes one pose, got a batch of shape {pq.shape[:-1]}; "
+                "pass stamps= for a dynamic edge"
+            )
+        t = None
+        pq = pq.reshape(1, 7)
+    else:
+        t = np.array(stamps, dtype=np.float64, ndmin=1)
+        pq = pq.reshape(-1, 7)
+        if t.ndim != 1 or t.shape[0] != pq.shape[0]:
+            raise ShapeError(
+                f"stamps of shape {np.shape(stamps)} for {pq.shape[0]} poses; "
+                "one stamp per pose"
+            )
+        bad = np.flatnonzero(~np.isfinite(t))
+        if bad.size:
+            i = int(bad[0])
+            raise TimestampError(f"stamps[{i}] is {float(t[i])!r}, not finite", index=(i,))
+    if cov is not None:
+        cov = np.array(cov, dtype=np.float64)
+        m = pq.shape[0]
+        if cov.shape == (6, 6):
+            cov = np.broadcast_to(cov, (m, 6, 6)).copy()
+        if cov.shape != (m, 6, 6):
+            raise ShapeError(f"cov: expected shape (6, 6) or ({m}, 6, 6), got {cov.shape}")
+    return t, np.ascontiguousarray(pq), cov
+
+
+class Snapshot:
+    """What a lookup reads of one edge: arrays that no writer changes afterwards.
+
+    ``t`` (N,) stamps (None for a static edge), ``pq`` (N, 7), ``cov`` (N, 6, 6)
+    or None; ``parent`` and ``child`` name the edge for error messages.
+    """
+
+    __slots__ = ("parent", "child", "t", "pq", "cov")
+
+    def __init__(self, parent, child, t, pq, cov):
+        self.parent, self.child, self.t, self.pq, self.cov = parent, child, t, pq, cov
+
+    @property
+    def static(self):
+        return self.t is None
+
+    def check(self, q, extrapolate):
+        """``q`` (float64 array) after the range test: raises or clamps.
+
+        Raises :class:`~rigidkit.ExtrapolationError` for a time outside
+        ``[t[0], t[-1]]`` (``extrapolate=None``), for one before ``t[0]``
+        (``"hold"``, which holds only the newest pose into the future).
+        """
+        t0, t1 = self.t[0], self.t[-1]
+        below = q < t0
+        above = q > t1
+        past = bool(below.any())
+        future = bool(above.any())
+        if not (past or future):
+            return q
+        if extrapolate == "clamp" or (extrapolate == "hold" and not past):
+            return np.clip(q, t0, t1)
+        mask = below if past else above
+        i = int(np.argmax(mask))
+        raise self.extrapolation_error(
+            float(q.reshape(-1)[i]), "past" if past else "future"
+        )
+
+    def extrapolation_error(self, time, direction):
+        t0, t1 = float(self.t[0]), float(self.t[-1])
+        where = "before" if direction == "past" else "after"
+        return ExtrapolationError(
+            f"edge {self.parent!r} -> {self.child!r}: time {time!r} is {where} its "
+            f"data [{t0!r}, {t1!r}] ({len(self.t)} samples); extrapolation into "
+            f"the {direction}",
+            edge=(self.parent, self.child),
+            range=(t0, t1),
+            direction=direction,
+        )
+
+    def locate(self, q):
+        """Segment index ``i`` and fraction ``a`` of each time: between ``t[i]`` and
+        ``t[i + 1]`` (``q`` already within range; ``i = 0``, ``a = 0`` for one sample)."""
+        t = self.t
+        n = t.shape[0]
+        if n == 1:
+            return np.zeros(q.shape, dtype=np.intp), np.zeros(q.shape)
+        i = np.searchsorted(t, q, side="right") - 1
+        np.clip(i, 0, n - 2, out=i)
+        t0 = t[i]
+        a = (q - t0) / (t[i + 1] - t0)
+        return i, a
+
+    def at(self, q, interpolation, want_cov=False):
+        """``parent_T_child`` at times ``q`` (shape (M,) array, within range).
+
+        Returns ``(Transform of shape (M,), cov (M, 6, 6) or None)``. Between two
+        samples: ``"decoupled"`` (tf2's rule) interpolates the translation
+        linearly and slerps the rotation; ``"screw"`` follows the SE(3) geodesic
+        ``T_i exp(a log(T_i^-1 T_{i+1}))`` (Sola et al. 2018, eq. 178). The
+        covariance is interpolated linearly, ``(1 - a) C_i + a C_{i+1}``.
+        """
+        i, a = self.locate(q)
+        pq = self.pq
+        if pq.shape[0] == 1:
+            T = wrap_pq(np.broadcast_to(pq[0], q.shape + (7,)).copy())
+            cov = None
+            if want_cov and self.cov is not None:
+                cov = np.broadcast_to(self.cov[0], q.shape + (6, 6)).copy()
+            return T, cov
+        T = slerp(
+            wrap_pq(pq[i]), wrap_pq(pq[i + 1]), a, decoupled=interpolation == "decoupled"
+        )
+        cov = None
+        if want_cov and self.cov is not None:
+            w = a[..., None, None]
+            cov = (1.0 - w) * self.cov[i] + w * self.cov[i + 1]
+        return T, cov
+
+    def body_twist(self, q, interpolation):
+        """Body twist ``vee(T^-1 dT/dt)`` of the interpolant at ``q``, shape (M, 6).
+
+        Constant on each segment: ``log(T_i^-1 T_{i+1}) / dt`` for ``"screw"``;
+        for ``"decoupled"``, ``(R(t)^T (p_{i+1} - p_i) / dt, log(R_i^T R_{i+1}) / dt)``
+        (the rotation part is the body angular velocity of the slerp). Zero for
+        a static edge or a single sample.
+        """
+        out = np.zeros(q.shape + (6,))
+        if self.t is None or self.t.shape[0] == 1:
+            return out
+        i, _ = self.locate(q)
+        dt = (self.t[i + 1] - self.t[i])[:, None]
+        T0, T1 = wrap_pq(self.pq[i]), wrap_pq(self.pq[i + 1])
+        if interpolation == "screw":
+            return np.asarray((T0.inv() @ T1).log()) / dt
+        omega = (T0.rotation.inv() @ T1.rotation).as_rotvec() / dt
+        T, _ = self.at(q, interpolation)
+        v = T.rotation.inv().apply((self.pq[i + 1, 4:] - self.pq[i, 4:]) / dt)
+        out[:, :3] = v
+        out[:, 3:] = omega
+        return out
+
+
+class EdgeBuffer:
+    """The samples of one edge ``parent -> child``, bounded in time and count.
+
+    Parameters
+    ----------
+    parent, child : str
+    t, pq, cov
+        Samples as :func:`as_samples` returns them (``t=None`` for a static edge).
+    max_duration : float or None
+        Samples older than ``newest - max_duration`` are dropped (tf2's cache
+        time); None keeps every sample.
+    max_samples : int or None
+        At most this many samples are kept (the newest).
+    """
+
+    __slots__ = ("parent", "child", "_t", "_pq", "_cov", "_lo", "_hi", "_limits")
+
+    def __init__(self, parent, child, t, pq, cov, max_duration, max_samples):
+        self.parent, self.child = parent, child
+        self._limits = (max_duration, max_samples)
+        self._t = None
+        self._pq, self._cov = pq, cov
+        self._lo, self._hi = 0, pq.shape[0]
+        if t is not None:
+            self._replace(*_merge(t[:0], pq[:0], None, t, pq, cov))
+
+    @property
+    def static(self):
+        return self._t is None
+
+    def __len__(self):
+        return self._hi - self._lo
+
+    def snapshot(self) -> Snapshot:
+        lo, hi = self._lo, self._hi
+        t = None if self._t is None else self._t[lo:hi]
+        cov = None if self._cov is None else self._cov[lo:hi]
+        return Snapshot(self.parent, self.child, t, self._pq[lo:hi], cov)
+
+    def set_static(self, pq, cov):
+        """Replace the pose of a static edge (new arrays: snapshots keep the old)."""
+        self._pq, self._cov, self._lo, self._hi = pq, cov, 0, 1
+
+    def insert(self, t, pq, cov):
+        """Add samples (any order); a stamp already held is replaced by the new pose."""
+        lo, hi = self._lo, self._hi
+        if (
+            t.shape[0] == 1
+            and t[0] > self._t[hi - 1]
+            and hi < self._t.shape[0]
+            and (cov is None) == (self._cov is None)
+        ):
+            # The common case, a newest sample: written past every snapshot's end.
+            self._t[hi] = t[0]
+            self._pq[hi] = pq[0]
+            if cov is not None:
+                self._cov[hi] = cov[0]
+            self._hi = hi + 1
+            self._trim()
+            return
+        old_cov = self._cov[lo:hi] if self._cov is not None else None
+        self._replace(*_merge(self._t[lo:hi], self._pq[lo:hi], old_cov, t, pq, cov))
+
+    def _replace(self, t, pq, cov):
+        n = t.shape[0]
+        cap = max(16, 2 * n)
+        self._t = np.empty(cap)
+        self._t[:n] = t
+        self._pq = np.empty((cap, 7))
+        self._pq[:n] = pq
+        if cov is None:
+            self._cov = None
+        else:
+            self._cov = np.empty((cap, 6, 6))
+            self._cov[:n] = cov
+        self._lo, self._hi = 0, n
+        self._trim()
+
+    def _trim(self):
+        max_duration, max_samples = self._limits
+        lo, hi = self._lo, self._hi
+        if max_duration is not None:
+            cut = self._t[hi - 1] - max_duration
+            if self._t[lo] < cut:
+                lo += int(np.searchsorted(self._t[lo:hi], cut, side="left"))
+        if max_samples is not None and hi - lo > max_samples:
+            lo = hi - max_samples
+        self._lo = lo
+
+
+def _merge(t0, pq0, cov0, t1, pq1, cov1):
+    """The samples of both sets in time order; at a repeated stamp the last one given wins.
+
+    A missing covariance (one set has them, the other not) is taken as zero: a
+    pose given without one is exact.
+    """
+    if cov0 is None and cov1 is not None:
+        cov0 = np.zeros((t0.shape[0], 6, 6))
+    if cov1 is None and cov0 is not None:
+        cov1 = np.zeros((t1.shape[0], 6, 6))
+    t = np.concatenate([t0, t1])
+    order = np.argsort(t, kind="stable")
+    ts = t[order]
+    # Stable sort keeps equal stamps in the order given: the last of each run wins.
+    keep = np.ones(ts.shape[0], dtype=bool)
+    keep[:-1] = ts[1:] != ts[:-1]
+    order = order[keep]
+    pq = np.concatenate([pq0, pq1])[order]
+    cov = None if cov0 is None else np.concatenate([cov0, cov1])[order]
+    return t[order], pq, cov
+
+
+def check_options(interpolation, extrapolate):
+    if interpolation not in _INTERPOLATION:
+        raise ValueError(
+            f"interpolation must be 'decoupled' or 'screw', got {interpolation!r}"
+        )
+    if extrapolate not in _EXTRAPOLATE:
+        raise ValueError(
+            f"extrapolate must be None, 'clamp' or 'hold', got {extrapolate!r}"
+        )

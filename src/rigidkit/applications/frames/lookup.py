@@ -1,0 +1,145 @@
+"""Lookups along a path of edge snapshots: poses, covariances and twists.
+
+A path from ``source`` to ``target`` through their common ancestor ``A`` is two
+chains of edges, each listed from the frame upwards: ``up_s`` from ``source`` to
+``A`` and ``up_t`` from ``target`` to ``A``. Then ``A_T_source`` is the product
+of ``up_s``'s edges ``parent_T_child`` from the top down, likewise ``A_T_target``,
+and ``target_T_source = A_T_target^-1 A_T_source``: one compose per edge and one
+inverse, on whole batches of stamps at once.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...errors import ExtrapolationError
+from ...objects import registry
+from ...objects.transform import Transform
+
+__all__ = ["latest_common_time", "chain", "compose_path", "body_twist_path", "shaped"]
+
+
+def latest_common_time(snaps):
+    """The newest time at which every dynamic edge of ``snaps`` has data (tf2's time 0).
+
+    ``None`` when every edge is static. Raises
+    :class:`~rigidkit.ExtrapolationError` when the ranges do not overlap, naming
+    the edge whose data end first.
+    """
+    dynamic = [s for s in snaps if s.t is not None]
+    if not dynamic:
+        return None
+    ends = [float(s.t[-1]) for s in dynamic]
+    k = int(np.argmin(ends))
+    latest = ends[k]
+    for s in dynamic:
+        if float(s.t[0]) > latest:
+            raise ExtrapolationError(
+                f"no common time on the path: edge {dynamic[k].parent!r} -> "
+                f"{dynamic[k].child!r} ends at {latest!r} (data "
+                f"[{float(dynamic[k].t[0])!r}, {latest!r}]) before edge "
+                f"{s.parent!r} -> {s.child!r} begins (data "
+                f"[{float(s.t[0])!r}, {float(s.t[-1])!r}])",
+                edge=(s.parent, s.child),
+                range=(float(s.t[0]), float(s.t[-1])),
+                direction="past",
+            )
+    return latest
+
+
+def _edge(snap, q, interpolation, extrapolate, want_cov):
+    """``parent_T_child`` of one edge at ``q`` (None: a single static pose)."""
+    if snap.t is None:
+        T = _static(snap)
+        cov = snap.cov[0] if (want_cov and snap.cov is not None) else None
+        return T, cov
+    q = snap.check(q, extrapolate)
+    return snap.at(q, interpolation, want_cov)
+
+
+def _static(snap):
+    from .buffer import wrap_pq
+
+    return wrap_pq(snap.pq[0])
+
+
+def chain(up, q, interpolation, extrapolate, want_cov=False):
+    """``A_T_frame`` along ``up`` (edges from the frame up to ``A``) at times ``q``.
+
+    Returns ``(Transform or None, [(edge pose, edge cov), ...] from the top down)``;
+    None stands for the identity (an empty chain).
+    """
+    parts = [_edge(s, q, interpolation, extrapolate, want_cov) for s in reversed(up)]
+    T = None
+    for E, _ in parts:
+        T = E if T is None else T @ E
+    return T, parts
+
+
+def compose_path(up_s, up_t, q, interpolation, extrapolate):
+    """``target_T_source`` at times ``q`` (an (M,) array, or None for static paths)."""
+    A_T_s, _ = chain(up_s, q, interpolation, extrapolate)
+    A_T_t, _ = chain(up_t, q, interpolation, extrapolate)
+    if A_T_t is None:
+        return A_T_s if A_T_s is not None else Transform()
+    if A_T_s is None:
+        return A_T_t.inv()
+    return A_T_t.inv() @ A_T_s
+
+
+def body_twist_path(up_s, up_t, q, interpolation, extrapolate):
+    """Body twist of ``target_T_source(t)`` at ``q``, shape (M, 6), and the pose.
+
+    For a product ``T = E_1 E_2 ... E_k`` the body twist is
+    ``sum_i Ad(E_{i+1} ... E_k)^-1 V_i`` with ``V_i`` each factor's body twist
+    (Murray, Li & Sastry 1994, Sec. 2.4); an inverted factor ``E^-1`` has body
+    twist ``-Ad(E) V``.
+    """
+    # Factors of target_T_source in order: the target chain inverted (bottom up),
+    # then the source chain (top down); each as a batch with its body twist.
+    factors = []
+    for s in up_t:
+        E, V = _moving_edge(s, q, interpolation, extrapolate)
+        factors.append((E.inv(), -_act(E.adjoint(), V)))
+    for s in reversed(up_s):
+        factors.append(_moving_edge(s, q, interpolation, extrapolate))
+    total = np.zeros(q.shape + (6,))
+    tail = None  # E_{i+1} ... E_k, built from the right
+    for E, V in reversed(factors):
+        if tail is None:
+            total = total + V
+            tail = E
+        else:
+            total = total + _act(tail.inv().adjoint(), V)
+            tail = E @ tail
+    if tail is None:
+        tail = Transform()
+    return total, tail
+
+
+def _act(M, v):
+    """``M @ v`` over a batch of matrices (M, 6, 6) and vectors (M, 6)."""
+    return np.einsum("...ij,...j->...i", np.asarray(M), v)
+
+
+def _moving_edge(s, q, interpolation, extrapolate):
+    """An edge's pose at ``q`` as a batch (M,) and its body twist (M, 6)."""
+    from .buffer import wrap_pq
+
+    if s.t is None:
+        E = wrap_pq(np.broadcast_to(s.pq[0], q.shape + (7,)).copy())
+        return E, np.zeros(q.shape + (6,))
+    q = s.check(q, extrapolate)
+    E, _ = s.at(q, interpolation)
+    return E, s.body_twist(q, interpolation)
+
+
+def shaped(T, shape):
+    """``T`` (shape (M,) of a flat query, or one pose) in the query's shape."""
+    from .buffer import wrap_pq
+
+    if T.single:
+        if shape:  # an all-static path asked at many times: the one pose, broadcast
+            return wrap_pq(np.broadcast_to(registry.stored(T), shape + (7,)).copy())
+        return T
+    return T.reshape(shape) if shape != T.shape else T

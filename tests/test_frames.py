@@ -1,0 +1,337 @@
+"""rk.FrameGraph: structure, lookups against explicit compositions with scipy, errors,
+time travel, velocities and thread safety."""
+
+import pickle
+import threading
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation as R
+from scipy.spatial.transform import Slerp as ScipySlerp
+
+import rigidkit as rk
+
+
+def matrices(pq):
+    """4x4 matrices of rows (tx, ty, tz, qx, qy, qz, qw)? No: of (p, q scalar first)."""
+    pq = np.asarray(pq).reshape(-1, 7)
+    M = np.tile(np.eye(4), (len(pq), 1, 1))
+    M[:, :3, :3] = R.from_quat(pq[:, 3:], scalar_first=True).as_matrix()
+    M[:, :3, 3] = pq[:, :3]
+    return M
+
+
+def random_pq(n, rng, scale=1.0):
+    q = R.random(n, rng=rng).as_quat(scalar_first=True)
+    return np.concatenate([rng.normal(scale=scale, size=(n, 3)), q], axis=1)
+
+
+def decoupled_reference(stamps, pq, times):
+    """tf2's rule with scipy: linear translation, scipy's Slerp for the rotation."""
+    M = np.tile(np.eye(4), (len(times), 1, 1))
+    rot = ScipySlerp(stamps, R.from_quat(pq[:, 3:], scalar_first=True))(times)
+    M[:, :3, :3] = rot.as_matrix()
+    for k in range(3):
+        M[:, k, 3] = np.interp(times, stamps, pq[:, k])
+    return M
+
+
+def screw_reference(stamps, pq, times):
+    """The SE(3) geodesic between neighbours with scipy's RigidTransform exp and log."""
+    from scipy.spatial.transform import RigidTransform
+
+    T = RigidTransform.from_matrix(matrices(pq))
+    i = np.clip(np.searchsorted(stamps, times, side="right") - 1, 0, len(stamps) - 2)
+    a = (times - stamps[i]) / (stamps[i + 1] - stamps[i])
+    step = (T[i].inv() * T[i + 1]).as_exp_coords()
+    return (T[i] * RigidTransform.from_exp_coords(a[:, None] * step)).as_matrix()
+
+
+@pytest.fixture
+def robot():
+    """map -> odom (dynamic) -> base (dynamic) -> arm -> camera (static), map -> tag."""
+    rng = np.random.default_rng(7)
+    t = np.sort(rng.uniform(0.0, 5.0, 40))
+    data = {
+        ("map", "odom"): (t, random_pq(40, rng)),
+        ("odom", "base"): (t[::2] + 0.01, random_pq(20, rng)),
+        ("base", "arm"): (None, random_pq(1, rng)),
+        ("arm", "camera"): (None, random_pq(1, rng)),
+        ("map", "tag"): (None, random_pq(1, rng)),
+    }
+    g = rk.FrameGraph(max_duration=None)
+    for (p, c), (s, pq) in data.items():
+        g.add(p, c, rk.Transform.from_pq(pq if s is not None else pq[0]), stamps=s)
+    return g, data
+
+
+def explicit(data, times, rule=decoupled_reference):
+    """tag_T_camera = (map_T_tag)^-1 map_T_odom odom_T_base base_T_arm arm_T_camera."""
+    M = {}
+    for (p, c), (s, pq) in data.items():
+        M[p, c] = matrices(pq)[0] if s is None else rule(s, pq, times)
+    return np.linalg.inv(M["map", "tag"]) @ (
+        M["map", "odom"] @ M["odom", "base"] @ M["base", "arm"] @ M["arm", "camera"]
+    )
+
+
+# -- structure --------------------------------------------------------------------------
+def test_structure(robot):
+    g, _ = robot
+    assert set(g.frames) == {"map", "odom", "base", "arm", "camera", "tag"}
+    assert g.parent("camera") == "arm" and g.parent("map") is None
+    assert g.children("map") == ["odom", "tag"]
+    assert g.path("camera", "tag") == ["camera", "arm", "base", "odom", "map", "tag"]
+    # through the common ancestor only: base is the top of camera -> odom
+    assert g.path("camera", "odom") == ["camera", "arm", "base", "odom"]
+    assert g.path("odom", "camera") == ["odom", "base", "arm", "camera"]
+    info = {e.child: e for e in g.edges}
+    assert info["odom"].kind == "dynamic" and info["odom"].count == 40
+    assert info["camera"].kind == "static" and info["camera"].range is None
+    g.remove("tag")
+    assert "tag" not in g.frames
+    with pytest.raises(rk.LookupError, match="'tag'"):
+        g.get("map", "tag")
+
+
+def test_second_parent_and_cycle_rejected(robot):
+    g, _ = robot
+    with pytest.raises(rk.ConnectivityError, match="'arm'.*'base'.*'map'"):
+        g.add("map", "arm", rk.Transform())
+    with pytest.raises(
+        rk.ConnectivityError, match="cycle map -> odom -> base -> arm -> camera -> map"
+    ):
+        g.add("camera", "map", rk.Transform())
+    with pytest.raises(rk.ConnectivityError, match="itself"):
+        g.add("a", "a", rk.Transform())
+    with pytest.raises(ValueError, match="update_static"):
+        g.add("base", "arm", rk.Transform())
+    new = rk.Transform(translation=[0.0, 0.0, 9.0])
+    g.update_static("base", "arm", new)
+    assert np.array_equal(g.get("base", "arm").translation, [0.0, 0.0, 9.0])
+
+
+# -- lookups ----------------------------------------------------------------------------
+@pytest.mark.parametrize("interpolation", ["decoupled", "screw"])
+def test_get_matches_explicit_composition(robot, interpolation):
+    g, data = robot
+    times = np.random.default_rng(1).uniform(0.5, 4.5, 200)
+    rule = decoupled_reference if interpolation == "decoupled" else screw_reference
+    want = explicit(data, times, rule)
+    got = g.get("tag", "camera", at=times, interpolation=interpolation)
+    assert got.shape == (200,)
+    np.testing.assert_allclose(got.as_matrix(), want, atol=1e-10)
+    # the reverse lookup is the inverse, and a single time equals the batch's row
+    back = g.get("camera", "tag", at=times, interpolation=interpolation)
+    np.testing.assert_allclose(back.as_matrix(), np.linalg.inv(want), atol=1e-10)
+    one = g.get("tag", "camera", at=float(times[3]), interpolation=interpolation)
+    assert one.shape == ()
+    np.testing.assert_allclose(one.as_matrix(), want[3], atol=1e-10)
+    grid = g.get("tag", "camera", at=times.reshape(20, 10), interpolation=interpolation)
+    assert grid.shape == (20, 10)
+
+
+def test_exact_at_samples_and_latest_common_time(robot):
+    g, data = robot
+    s, pq = data["map", "odom"]
+    np.testing.assert_allclose(
+        g.get("map", "odom", at=s).as_matrix(), matrices(pq), atol=1e-15
+    )
+    latest = min(data["map", "odom"][0][-1], data["odom", "base"][0][-1])
+    np.testing.assert_allclose(
+        g.get("tag", "camera").as_matrix(), explicit(data, [latest])[0], atol=1e-10
+    )
+    static = g.get("tag", "arm", at=None)  # crosses the dynamic edges, so at=None
+    assert static.shape == ()
+    assert g.get("arm", "camera", at=[1.0, 2.0]).shape == (2,)  # static, broadcast
+
+
+def test_insertion_order_repeats_and_trajectory():
+    rng = np.random.default_rng(3)
+    t = np.arange(10.0)
+    pq = random_pq(10, rng)
+    perm = rng.permutation(10)
+    g = rk.FrameGraph(max_duration=None)
+    for i in perm:  # one at a time, out of order
+        g.add("a", "b", rk.Transform.from_pq(pq[i]), stamps=t[i])
+    h = rk.FrameGraph(max_duration=None)
+    h.add("a", "b", rk.Trajectory(t, rk.Transform.from_pq(pq)))
+    np.testing.assert_array_equal(
+        g.get("a", "b", at=t).as_matrix(), h.get("a", "b", at=t).as_matrix()
+    )
+    replaced = random_pq(1, rng)[0]
+    g.add("a", "b", rk.Transform.from_pq(replaced), stamps=4.0)
+    np.testing.assert_allclose(g.get("a", "b", at=4.0).as_matrix(), matrices(replaced)[0])
+    assert g.edges[0].count == 10
+
+
+def test_buffer_limits():
+    g = rk.FrameGraph(max_duration=2.0)
+    for k in range(50):
+        g.add("a", "b", rk.Transform(translation=[k, 0.0, 0.0]), stamps=0.1 * k)
+    (e,) = g.edges
+    # tf2 keeps every sample not older than newest - cache time
+    assert e.range[1] == pytest.approx(4.9) and e.range[0] == pytest.approx(2.9)
+    assert e.count == 21
+    g = rk.FrameGraph(max_duration=None, max_samples=5)
+    g.add("a", "b", rk.Transform(translation=np.ones((30, 3))), stamps=np.arange(30.0))
+    assert g.edges[0].count == 5 and g.edges[0].range == (25.0, 29.0)
+
+
+# -- errors -----------------------------------------------------------------------------
+def test_extrapolation_errors(robot):
+    g, data = robot
+    t0, t1 = data["map", "odom"][0][[0, -1]]
+    with pytest.raises(rk.ExtrapolationError, match="'map' -> 'odom'") as err:
+        g.get("map", "odom", at=[t0 + 0.1, t1 + 1.0])
+    assert err.value.direction == "future" and err.value.edge == ("map", "odom")
+    assert err.value.range == (t0, t1) and isinstance(err.value, ValueError)
+    assert pickle.loads(pickle.dumps(err.value)).direction == "future"
+    with pytest.raises(rk.ExtrapolationError) as err:
+        g.get("map", "odom", at=t0 - 1.0)
+    assert err.value.direction == "past"
+    assert str(t0) in str(err.value)
+    clamp = g.get("map", "odom", at=[t0 - 1.0, t1 + 1.0], extrapolate="clamp")
+    np.testing.assert_allclose(
+        clamp.as_matrix(), g.get("map", "odom", at=[t0, t1]).as_matrix(), atol=0
+    )
+    hold = g.get("map", "odom", at=t1 + 1.0, extrapolate="hold")
+    np.testing.assert_allclose(hold.as_matrix(), g.get("map", "odom", at=t1).as_matrix())
+    with pytest.raises(rk.ExtrapolationError, match="past"):
+        g.get("map", "odom", at=t0 - 1.0, extrapolate="hold")
+    ok, reason = g.can_transform("map", "odom", at=t1 + 1.0)
+    assert not ok and "future" in reason
+    assert g.can_transform("map", "camera", at=t1 - 0.5) == (True, "")
+
+
+def test_connectivity_and_lookup_errors(robot):
+    g, _ = robot
+    g.add("world", "other", rk.Transform())
+    with pytest.raises(rk.ConnectivityError, match="'map'.*'world'|'world'.*'map'"):
+        g.get("camera", "other")
+    with pytest.raises(rk.LookupError, match="closest: 'camera'") as err:
+        g.get("map", "camra")
+    assert isinstance(err.value, ValueError) and not isinstance(err.value, KeyError)
+    ok, reason = g.can_transform("map", "camra")
+    assert not ok and "camra" in reason
+
+
+# -- time travel and velocities ---------------------------------------------------------
+def test_time_travel(robot):
+    g, data = robot
+    a, b = 1.3, 3.7
+    got = g.get("camera", "camera", at=a, source_at=b, fixed="map")
+    want = np.linalg.inv(explicit(data, [a])[0]) @ explicit(data, [b])[0]
+    # camera at a <- tag (fixed, static in map) -> camera at b
+    np.testing.assert_allclose(got.as_matrix(), want, atol=1e-10)
+    with pytest.raises(ValueError, match="fixed"):
+        g.get("camera", "camera", at=a, source_at=b)
+
+
+def test_velocity_against_finite_differences_and_twist_from_samples(robot):
+    g, _ = robot
+    times = np.array([0.8, 1.9, 3.3])
+    h = 1e-6
+    for frame in ("body", "world"):
+        for interpolation in ("decoupled", "screw"):
+            V = g.velocity("tag", "camera", times, frame=frame, interpolation=interpolation)
+            T0 = g.get("tag", "camera", times - h, interpolation=interpolation).as_matrix()
+            T1 = g.get("tag", "camera", times + h, interpolation=interpolation).as_matrix()
+            T = g.get("tag", "camera", times, interpolation=interpolation).as_matrix()
+            for k in range(3):
+                dT = (T1[k] - T0[k]) / (2 * h)
+                X = (
+                    np.linalg.inv(T[k]) @ dT
+                    if frame == "body"
+                    else dT @ np.linalg.inv(T[k])
+                )
+                want = np.r_[X[:3, 3], X[2, 1], X[0, 2], X[1, 0]]
+                np.testing.assert_allclose(V[k], want, rtol=1e-5, atol=1e-5)
+    # a constant screw motion sampled: the samples' finite differences agree
+    xi = np.array([0.3, -0.1, 0.2, 0.1, 0.4, -0.2])
+    t = np.linspace(0.0, 2.0, 201)
+    g = rk.FrameGraph(max_duration=None)
+    g.add("w", "b", rk.Transform.exp(t[:, None] * xi), stamps=t)
+    V = g.velocity("w", "b", t[1:-1], frame="body", interpolation="screw")
+    ref = rk.kinematics.twist_from_samples(
+        rk.Transform.exp(t[:, None] * xi), t, frame="body"
+    )
+    np.testing.assert_allclose(V, ref[1:-1], atol=1e-4)
+    np.testing.assert_allclose(V, np.broadcast_to(xi, V.shape), atol=1e-12)
+
+
+# -- threads ----------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    "n_stamps", [3000, pytest.param(12500, marks=pytest.mark.exhaustive)]
+)
+def test_threads_stress(n_stamps):
+    """4 writers (one edge each, out of order within bursts of 4) and 4 readers,
+    ~8 n_stamps operations (1e5 in the exhaustive run): no exception, and every lookup
+    that succeeds equals the single-threaded composition of the written samples (a
+    torn read would not)."""
+    chains = [("m", "a"), ("a", "b"), ("b", "c"), ("m", "d")]
+    rng = np.random.default_rng(11)
+    stamps = np.arange(n_stamps) * 0.01
+    poses = {e: rk.Transform.from_pq(random_pq(n_stamps, rng)) for e in chains}
+    written = {e: np.zeros(n_stamps, dtype=bool) for e in chains}
+    g = rk.FrameGraph(max_duration=10.0)
+    for e in chains:  # the first two samples, so that readers find every frame
+        g.add(*e, poses[e][:2], stamps=stamps[:2])
+        written[e][:2] = True
+    errors, counts, done = [], {"exact": 0, "past": 0, "reads": 0}, threading.Event()
+    progress = dict.fromkeys(chains, 2)
+
+    def writer(e, seed):
+        order = np.arange(2, n_stamps)
+        r = np.random.default_rng(seed)
+        for k in range(0, len(order) - 4, 4):
+            order[k : k + 4] = r.permutation(order[k : k + 4])
+        try:
+            for j, k in enumerate(order):
+                g.add(*e, poses[e][int(k)], stamps=stamps[k])
+                written[e][k] = True
+                progress[e] = j + 2
+        except Exception as exc:  # reported by the assertion below
+            errors.append(exc)
+
+    def reader(seed):
+        r = np.random.default_rng(seed)
+        try:
+            while not done.is_set() or counts["reads"] < n_stamps:
+                # stamps every writer has reached, and not yet trimmed by the fastest
+                lo, hi = max(progress.values()) - 900, min(progress.values())
+                if lo >= hi:
+                    continue
+                k = int(r.integers(max(0, lo), hi))
+                if not all(written[e][k] for e in chains):
+                    continue
+                counts["reads"] += 1
+                try:
+                    got = g.get("d", "c", at=stamps[k])
+                except rk.ExtrapolationError as exc:
+                    assert exc.direction == "past"  # trimmed by max_duration
+                    counts["past"] += 1
+                    continue
+                want = (
+                    poses["m", "d"][k].inv()
+                    @ poses["m", "a"][k]
+                    @ poses["a", "b"][k]
+                    @ poses["b", "c"][k]
+                )
+                np.testing.assert_allclose(got.as_matrix(), want.as_matrix(), atol=1e-12)
+                counts["exact"] += 1
+        except Exception as exc:
+            errors.append(exc)
+
+    writers = [threading.Thread(target=writer, args=(e, i)) for i, e in enumerate(chains)]
+    readers = [threading.Thread(target=reader, args=(10 + i,)) for i in range(4)]
+    for th in writers + readers:
+        th.start()
+    for th in writers:
+        th.join()
+    done.set()
+    for th in readers:
+        th.join()
+    assert not errors, errors[:3]
+    assert counts["exact"] > n_stamps // 2, counts
+    assert g.edges[0].count <= 1001  # 10 s of samples at 100 Hz
