@@ -159,7 +159,10 @@ def test_batched_and_validation(pair):
 
 
 def test_against_gtsam_jacobians(pair):
-    gtsam = pytest.importorskip("gtsam")
+    try:  # a wheel built for a newer NumPy than CI's floor may fail on import
+        import gtsam
+    except Exception as err:  # ImportError, or what a binary mismatch raises
+        pytest.skip(f"gtsam not usable: {err}")
     X, Y, rng = pair
 
     def pose(T):
