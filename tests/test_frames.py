@@ -335,3 +335,47 @@ def test_threads_stress(n_stamps):
     assert not errors, errors[:3]
     assert counts["exact"] > n_stamps // 2, counts
     assert g.edges[0].count <= 1001  # 10 s of samples at 100 Hz
+
+
+# -- files and pictures -----------------------------------------------------------------
+def test_json_round_trip_is_exact(robot):
+    g, _ = robot
+    g.add(
+        "map",
+        "gps",
+        rk.Transform(translation=[1.0, 2.0, 3.0]),
+        stamps=[0.1],
+        cov=np.diag(np.arange(1.0, 7.0)) / 3.0,
+    )
+    h = rk.FrameGraph.from_json(g.to_json())
+    assert h.edges == g.edges and h.frames == g.frames
+    assert (h.max_duration, h.max_samples) == (g.max_duration, g.max_samples)
+    t = np.linspace(0.5, 4.5, 50)
+    np.testing.assert_array_equal(
+        h.get("tag", "camera", at=t).as_matrix(), g.get("tag", "camera", at=t).as_matrix()
+    )
+    snap = {s.child: s for s in (e.snapshot() for e in g._edges.values())}
+    for e in h._edges.values():
+        s = e.snapshot()
+        np.testing.assert_array_equal(s.pq, snap[s.child].pq)
+        np.testing.assert_array_equal(s.t, snap[s.child].t)
+    np.testing.assert_array_equal(
+        h.get("map", "gps", at=0.1, with_covariance=True).cov,
+        np.diag(np.arange(1.0, 7.0)) / 3,
+    )
+    with pytest.raises(ValueError, match="not a rigidkit.FrameGraph"):
+        rk.FrameGraph.from_json('{"format": "x"}')
+
+
+def test_text_and_dot(robot):
+    g, data = robot
+    text = str(g)
+    t0, t1 = (float(x) for x in data["map", "odom"][0][[0, -1]])
+    assert text.splitlines()[0] == "map"
+    assert f"├── odom  [dynamic, 40 samples, t in [{t0!r}, {t1!r}]]" in text
+    assert "│       └── arm  [static]" in text
+    assert "└── tag  [static]" in text
+    dot = g.to_dot()
+    assert dot.startswith("digraph FrameGraph {") and dot.endswith("}")
+    assert '"arm" -> "camera" [label="static", style=dashed];' in dot
+    assert dot.count("->") == 5

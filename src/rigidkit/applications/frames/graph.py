@@ -68,6 +68,12 @@ class FrameGraph:
     array([0.5, 0. , 1.5])
     >>> graph.path("camera", "map")
     ['camera', 'base', 'map']
+    >>> print(graph)
+    map
+    └── base  [dynamic, 2 samples, t in [0.0, 1.0]]
+        └── camera  [static]
+    >>> rk.FrameGraph.from_json(graph.to_json()).edges == graph.edges
+    True
     """
 
     def __init__(self, max_duration=10.0, max_samples=None):
@@ -115,13 +121,11 @@ class FrameGraph:
         with self._lock:
             edge = self._edges.get(child)
             if edge is None:
-                self._check_new_edge(parent, child)
-                self._edges[child] = EdgeBuffer(
-                    parent, child, t, pq, cov, self.max_duration, self.max_samples
+                self._attach_locked(
+                    EdgeBuffer(
+                        parent, child, t, pq, cov, self.max_duration, self.max_samples
+                    )
                 )
-                self._children.setdefault(parent, []).append(child)
-                self._children.setdefault(child, [])
-                self._paths.clear()
                 return
             self._check_parent(edge, parent, child)
             if edge.static or t is None:
@@ -165,6 +169,21 @@ class FrameGraph:
                 if not self._children.get(name) and name not in self._edges:
                     self._children.pop(name, None)
             self._paths.clear()
+
+    def _attach(self, edge):
+        """Add a new edge built elsewhere (``from_json``)."""
+        with self._lock:
+            if edge.child in self._edges:
+                self._check_parent(self._edges[edge.child], edge.parent, edge.child)
+                raise ValueError(f"edge {edge.parent!r} -> {edge.child!r} given twice")
+            self._attach_locked(edge)
+
+    def _attach_locked(self, edge):
+        self._check_new_edge(edge.parent, edge.child)
+        self._edges[edge.child] = edge
+        self._children.setdefault(edge.parent, []).append(edge.child)
+        self._children.setdefault(edge.child, [])
+        self._paths.clear()
 
     def _check_parent(self, edge, parent, child):
         if edge.parent != parent:
