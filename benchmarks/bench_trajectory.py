@@ -233,7 +233,7 @@ def run_case(name, repeat, all_pairs_max, min_sample):
         for row, fns in rows.items():
             timed = {k: f for k, f in fns.items() if f is not None}
             results[row] = C.interleaved_medians(
-                timed, repeat=repeat, min_sample=min_sample, warmup=1
+                timed, repeat=repeat, min_sample=min_sample, warmup=0
             )
         return results, checks, pairs, pairs_ok
 

@@ -226,3 +226,13 @@ def test_convert_is_unchanged(capsys):
     )
     assert code == 0
     assert out == "quat:xyzw  x y z w  0.000000  0.000000  0.707107  0.707107\n"
+
+
+def test_help_lists_the_trajectory_commands(capsys):
+    code, out, _ = _run(capsys, "--help")
+    assert code == 0
+    assert "ape       absolute pose error" in out
+    assert "KITTI odometry errors (% and deg/100 m" in out
+    for command in ("ape", "rpe", "kitti"):
+        code, out, _ = _run(capsys, command, "--help")
+        assert code == 0 and "--align {none,se3,sim3,scale,yaw,origin}" in out

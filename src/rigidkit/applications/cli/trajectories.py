@@ -150,7 +150,7 @@ def add_trajectory_commands(commands) -> None:
     rpe.set_defaults(func=run_rpe)
     kitti = commands.add_parser(
         "kitti",
-        help="KITTI odometry errors (% and deg/100 m over 100-800 m segments)",
+        help="KITTI odometry errors (%% and deg/100 m over 100-800 m segments)",
         description=(
             "The KITTI odometry benchmark's errors: drift over path segments of\n"
             "100, 200, ..., 800 m starting every 10th frame (Geiger et al. 2012)."
