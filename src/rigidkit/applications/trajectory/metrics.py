@@ -200,21 +200,17 @@ def ape(ref, est, relation="translation", degrees=False):
 
 
 def _angles_to_next(poses):
-    """The rotation angle between consecutive poses, shape (N - 1,)."""
+    """The rotation angle between consecutive poses, shape (N - 1,).
+
+    ``2 acos|a.b|`` loses precision near 0; with ``s = sign(a.b)`` (1 at 0), the
+    same angle is ``4 atan2(|a - s b|, |a + s b|)`` (the half-angle between the
+    unit quaternions on the 3-sphere), accurate everywhere.
+    """
     q = np.asarray(poses.rotation.as_quat())
-    dot = np.abs(np.einsum("...i,...i->...", q[:-1], q[1:]))
-    return _angle_from_dot(dot, q[:-1], q[1:])
-
-
-def _angle_from_dot(dot, a, b):
-    # 2 acos|a.b| loses precision near 0; 2 atan2(|a - b s|, |a + b s|) with
-    # s = sign(a.b) is the same angle, accurate everywhere.
-    s = np.where(dot >= 0, 1.0, -1.0)[..., None] if False else None
-    del s
-    sgn = np.sign(np.einsum("...i,...i->...", a, b))
-    sgn = np.where(sgn == 0, 1.0, sgn)[..., None]
+    a, b = q[:-1], q[1:]
+    s = np.where(np.einsum("ij,ij->i", a, b) < 0.0, -1.0, 1.0)[:, None]
     return 4.0 * np.arctan2(
-        np.linalg.norm(a - sgn * b, axis=-1), np.linalg.norm(a + sgn * b, axis=-1)
+        np.linalg.norm(a - s * b, axis=-1), np.linalg.norm(a + s * b, axis=-1)
     )
 
 
