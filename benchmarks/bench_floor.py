@@ -12,7 +12,7 @@ side by side in one process (median of round-robin samples), at N = 1, 10, 100,
   loop and returns a new array can cost;
 * ``numba + empty + object``: the same, wrapped into a new ``Rotation`` (the
   least a method returning an object can cost);
-* ``functional``: ``rk.conversions.quat_compose`` / ``quat_conjugate`` (the
+* ``functional``: ``rk.conversions.quat_compose`` / ``rk.quaternion.conjugate`` (the
   kernel's generated entry point: shape, dtype and contiguity checks);
 * ``Rotation``: ``a @ b`` / ``a.inv()``.
 
@@ -44,14 +44,14 @@ def main() -> None:
     import rigidkit as rk
     from rigidkit._engine.dispatch import entry_point
     from rigidkit.functional import conversions as conv
+    from rigidkit.functional import quaternion as quat
 
     rng = np.random.default_rng(0)
     big = rk.Rotation.from_quat(rng.standard_normal((5000, 4)))
     big @ big, big.inv()  # start the compiled loops
     deadline = time.time() + 60
     while not (
-        conv.quat_compose._ready.get((False, False))
-        and conv.quat_conjugate._ready.get((False,))
+        conv.quat_compose._ready.get((False, False)) and quat.conjugate._ready.get((False,))
     ):
         if time.time() > deadline:
             raise SystemExit("the compiled loops did not load within 60 s")
@@ -60,13 +60,13 @@ def main() -> None:
     # The compiled entry points, as the fast path calls them (no numba typing).
     f64 = np.dtype(np.float64)
     compose_loop = entry_point(conv.quat_compose._ready[(False, False)][f64])
-    conj_loop = entry_point(conv.quat_conjugate._ready[(False,)][f64])
+    conj_loop = entry_point(quat.conjugate._ready[(False,)][f64])
 
     rows = []
     for n in args.sizes:
         a = rk.Rotation.from_quat(rng.standard_normal((n, 4)))
         b = rk.Rotation.from_quat(rng.standard_normal((n, 4)))
-        for op, fns in _contenders(a, b, compose_loop, conj_loop, conv, quaternion):
+        for op, fns in _contenders(a, b, compose_loop, conj_loop, conv, quat, quaternion):
             res = interleaved_medians(fns, repeat=args.repeat)
             us = {k: v["median"] * 1e6 for k, v in res.items()}
             rows.append(
@@ -147,7 +147,7 @@ def _random_matrices(rk, rng, n):
 NAMES = ("np-quat", "numba + empty", "numba + empty + object", "functional", "Rotation")
 
 
-def _contenders(a, b, compose_loop, conj_loop, conv, quaternion):
+def _contenders(a, b, compose_loop, conj_loop, conv, quat, quaternion):
     """``(op, {name: callable})`` for ``compose`` and ``inv`` of batches ``a``, ``b``."""
     n = a.shape[0]
     wrap = type(a)._wrap
@@ -173,7 +173,7 @@ def _contenders(a, b, compose_loop, conj_loop, conv, quaternion):
                 "np-quat": lambda: npa.conj(),
                 "numba + empty": lambda: conj_loop(ra, np.empty((n, 4))),
                 "numba + empty + object": lambda: wrap(conj_loop(ra, np.empty((n, 4)))),
-                "functional": lambda: conv.quat_conjugate(ra),
+                "functional": lambda: quat.conjugate(ra),
                 "Rotation": lambda: a.inv(),
             },
         ),

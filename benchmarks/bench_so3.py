@@ -283,9 +283,9 @@ def build_rows(libs: Libs) -> list:
         )
 
     r = row("inv out=", ([4], 4), True, "rot")
-    r.notes["rigidkit"] = "rk.conversions.quat_conjugate(q, out=)"
+    r.notes["rigidkit"] = "rk.quaternion.conjugate(q, out=)"
     r.impls["rigidkit"] = lambda d: partial(
-        rk.conversions.quat_conjugate, d.q1, out=buffer(d.q1.shape)
+        rk.quaternion.conjugate, d.q1, out=buffer(d.q1.shape)
     )
     if nq:
         r.impls["numpy-quaternion"] = batched(

@@ -9,11 +9,12 @@ a rotation, as in :meth:`rigidkit.Rotation.from_quat`), and a zero or non-finite
 one raises :class:`~rigidkit.ZeroNormError` or :class:`~rigidkit.NonFiniteError`
 naming its batch index.
 
-``quat_conjugate`` and ``quat_canonical`` are quaternion algebra, defined for
-every quaternion: they take it as it is (no normalisation). ``quat_compose`` is
-the Hamilton product (:func:`rigidkit.quaternion.multiply`, the bare kernel call)
-as the composition of rotations (``q2`` first), renormalised so that long chains
-of compositions stay unit to a few ulp (``Rotation @`` uses it).
+``quat_canonical`` takes any quaternion as it is (no normalisation). The product
+and the conjugate of the algebra are :func:`rigidkit.quaternion.multiply` and
+:func:`rigidkit.quaternion.conjugate` (the conjugate of a unit quaternion is the
+inverse rotation); ``quat_compose`` is the product as the composition of rotations
+(``q2`` first), renormalised so that long chains of compositions stay unit to a
+few ulp (``Rotation @`` uses it).
 
 Unchecked variants: ``matrix_from_quat_unchecked``, ``rotvec_from_quat_unchecked``,
 ``mrp_from_quat_unchecked``, ``axis_angle_from_quat_unchecked``,
@@ -62,7 +63,6 @@ __all__ = [
     "quat_normalize",
     "quat_canonical",
     "quat_compose",
-    "quat_conjugate",
     "quat_apply",
     "quat_angle_between",
     "matrix_from_quat",
@@ -80,7 +80,6 @@ __all__ = [
 ]
 
 quat_compose = _q.quat_compose  # the product as composition of rotations: renormalised
-quat_conjugate = _q.quat_conjugate
 quat_canonical = _q.quat_canonical
 
 # The unchecked variants (module docs): the kernels, for quaternions known to be unit.

@@ -19,8 +19,13 @@ array([ 0.,  0.,  0., -1.])
 array([-1.,  0.,  0.,  0.])
 
 :func:`multiply` is the product kernel itself, ``q1 q2 = (w1 w2 - v1.v2, w1 v2 +
-w2 v1 + v1 x v2)`` for shapes (..., 4) broadcasting, with the kernels' ``out=``
-(a NumPy buffer of the result's shape): the one name of the Hamilton product.
+w2 v1 + v1 x v2)`` for shapes (..., 4) broadcasting, and :func:`conjugate` the
+conjugate kernel, ``q* = (w, -v)`` with ``(q1 q2)* = q2* q1*`` (for a unit
+quaternion, the inverse rotation); both take the kernels' ``out=`` (a NumPy buffer
+of the result's shape). They are the one name of each operation in rigidkit.
+
+>>> conjugate([1.0, 2.0, 3.0, 4.0])
+array([ 1., -2., -3., -4.])
 """
 
 from __future__ import annotations
@@ -55,14 +60,11 @@ def _reject_zero(result, largest, what):
     return result
 
 
-# The Hamilton product of any quaternions (module docs): the kernel itself, so that a
-# call costs no Python frame beyond the kernel's fast entry and takes ``out=``.
+# The Hamilton product and the conjugate of any quaternions (module docs): the
+# kernels themselves, so that a call costs no Python frame beyond the kernel's fast
+# entry and takes ``out=``.
 multiply = _kq.quat_multiply
-
-
-def conjugate(q):
-    """Conjugate ``q* = (w, -v)``, shape (..., 4); ``(q1 q2)* = q2* q1*``."""
-    return _kq.quat_conjugate(_quat(q))
+conjugate = _kq.quat_conjugate
 
 
 def norm(q):

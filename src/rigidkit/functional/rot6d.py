@@ -5,7 +5,7 @@ R10, R20, R01, R11, R21)`` (matrices active, on column vectors, ``v_A = A_R_B @
 v_B``), as in the paper (its ``g_GS`` maps two columns to ``[b1 b2 b3]`` by
 Gram-Schmidt). pytorch3d's ``matrix_to_rotation_6d`` takes the first two ROWS
 instead, i.e. our 6D of the inverse rotation (``R^T``): convert with
-``rot6d_from_quat(quat_conjugate(q))``. Quaternions Hamilton, scalar first.
+``rot6d_from_quat(rk.quaternion.conjugate(q))``. Quaternions Hamilton, scalar first.
 
 Any 6 numbers whose two 3-vectors are not parallel (nor zero) name a rotation,
 which makes the representation continuous where quaternions and Euler angles are

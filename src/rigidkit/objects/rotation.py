@@ -19,6 +19,7 @@ from ..functional import davenport as _dav
 from ..functional import distances as _dist
 from ..functional import euler
 from ..functional import interpolation as _interp
+from ..functional import quaternion as _quaternion
 from ..functional import rot6d as _r6
 from ..functional import sequences as _seq
 from ..functional import so3 as _so3
@@ -57,7 +58,7 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
     _trail = (4,)
     _identity = (1.0, 0.0, 0.0, 0.0)
     _compose_kernel = _conv.quat_compose
-    _inverse_kernel = _conv.quat_conjugate
+    _inverse_kernel = _quaternion.conjugate
     dof, matrix_size, point_dim = 3, 3, 3
     _spec = GroupSpec(
         algebra=_so3,
@@ -358,7 +359,7 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
                [ 1.,  1.,  2.]])
         """
         v = as_array(vectors, (3,), "vectors")
-        q = _conv.quat_conjugate(self._quat) if inverse else self._quat
+        q = _quaternion.conjugate(self._quat) if inverse else self._quat
         return _conv.quat_apply_unchecked(q, v, out=out)
 
     def inv(self):
