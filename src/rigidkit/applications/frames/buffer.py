@@ -88,14 +88,50 @@ class Snapshot:
     or None; ``parent`` and ``child`` name the edge for error messages.
     """
 
-    __slots__ = ("parent", "child", "t", "pq", "cov")
+    __slots__ = ("parent", "child", "t", "pq", "cov", "pose")
 
     def __init__(self, parent, child, t, pq, cov):
         self.parent, self.child, self.t, self.pq, self.cov = parent, child, t, pq, cov
+        #: a static edge's pose, made once (snapshots are cached by their buffer)
+        self.pose = wrap_pq(pq[0]) if t is None else None
 
     @property
     def static(self):
         return self.t is None
+
+    def check_one(self, q, extrapolate):
+        """:meth:`check` of one time, a Python float (the single lookup's path)."""
+        t0, t1 = float(self.t[0]), float(self.t[-1])
+        if q < t0:
+            if extrapolate == "clamp":
+                return t0
+            raise self.extrapolation_error(q, "past")
+        if q > t1:
+            if extrapolate is not None:
+                return t1
+            raise self.extrapolation_error(q, "future")
+        return q
+
+    def at_one(self, q, interpolation, want_cov=False):
+        """:meth:`at` of one time (a float within range): a single ``Transform``."""
+        t, pq = self.t, self.pq
+        n = t.shape[0]
+        i = min(max(int(t.searchsorted(q, side="right")) - 1, 0), n - 2) if n > 1 else 0
+        t0 = float(t[i])
+        a = 0.0 if n == 1 else (q - t0) / (float(t[i + 1]) - t0)
+        if a == 0.0:  # at a sample (slerp's value at 0 too, without the call)
+            T = wrap_pq(pq[i])
+        else:
+            T = slerp(
+                wrap_pq(pq[i]),
+                wrap_pq(pq[i + 1]),
+                a,
+                decoupled=interpolation == "decoupled",
+            )
+        cov = None
+        if want_cov and self.cov is not None:
+            cov = self.cov[i] if a == 0.0 else (1.0 - a) * self.cov[i] + a * self.cov[i + 1]
+        return T, cov
 
     def check(self, q, extrapolate):
         """``q`` (float64 array) after the range test: raises or clamps.
@@ -209,11 +245,12 @@ class EdgeBuffer:
         At most this many samples are kept (the newest).
     """
 
-    __slots__ = ("parent", "child", "_t", "_pq", "_cov", "_lo", "_hi", "_limits")
+    __slots__ = ("parent", "child", "_t", "_pq", "_cov", "_lo", "_hi", "_limits", "_snap")
 
     def __init__(self, parent, child, t, pq, cov, max_duration, max_samples):
         self.parent, self.child = parent, child
         self._limits = (max_duration, max_samples)
+        self._snap = None
         self._t = None
         self._pq, self._cov = pq, cov
         self._lo, self._hi = 0, pq.shape[0]
@@ -228,14 +265,19 @@ class EdgeBuffer:
         return self._hi - self._lo
 
     def snapshot(self) -> Snapshot:
-        lo, hi = self._lo, self._hi
-        t = None if self._t is None else self._t[lo:hi]
-        cov = None if self._cov is None else self._cov[lo:hi]
-        return Snapshot(self.parent, self.child, t, self._pq[lo:hi], cov)
+        """The current samples (cached until the next change: lookups take it often)."""
+        snap = self._snap
+        if snap is None:
+            lo, hi = self._lo, self._hi
+            t = None if self._t is None else self._t[lo:hi]
+            cov = None if self._cov is None else self._cov[lo:hi]
+            snap = self._snap = Snapshot(self.parent, self.child, t, self._pq[lo:hi], cov)
+        return snap
 
     def set_static(self, pq, cov):
         """Replace the pose of a static edge (new arrays: snapshots keep the old)."""
         self._pq, self._cov, self._lo, self._hi = pq, cov, 0, 1
+        self._snap = None
 
     def insert(self, t, pq, cov):
         """Add samples (any order); a stamp already held is replaced by the new pose."""
@@ -253,6 +295,7 @@ class EdgeBuffer:
                 self._cov[hi] = cov[0]
             self._hi = hi + 1
             self._trim()
+            self._snap = None
             return
         old_cov = self._cov[lo:hi] if self._cov is not None else None
         self._replace(*_merge(self._t[lo:hi], self._pq[lo:hi], old_cov, t, pq, cov))
@@ -271,6 +314,7 @@ class EdgeBuffer:
             self._cov[:n] = cov
         self._lo, self._hi = 0, n
         self._trim()
+        self._snap = None
 
     def _trim(self):
         max_duration, max_samples = self._limits

@@ -14,8 +14,15 @@ from ...errors import (
     FrameKeywordError,
     LookupError,
 )
+from ...objects.transform import Transform
 from .buffer import EdgeBuffer, as_samples, check_options
-from .lookup import body_twist_path, compose_path, latest_common_time, shaped
+from .lookup import (
+    body_twist_path,
+    compose_path,
+    fold_static,
+    latest_common_time,
+    shaped,
+)
 
 __all__ = ["FrameGraph", "EdgeInfo"]
 
@@ -154,6 +161,7 @@ class FrameGraph:
             else:
                 self._check_parent(edge, parent, child)
                 edge.set_static(pq, cov)
+                self._paths.clear()  # the plans hold composed static poses
                 return
         self.add(parent, child, parent_T_child, cov=cov)
 
@@ -287,6 +295,22 @@ class FrameGraph:
             up_s, up_t = self._resolve(target, source)
             return [e.snapshot() for e in up_s], [e.snapshot() for e in up_t]
 
+    def _planned(self, target, source):
+        """The two chains of :meth:`_resolve` with each run of static edges composed
+        once (cached with the path until the tree or a static pose changes), and a
+        snapshot of each dynamic edge: ``(items_s, items_t)``, each item a static
+        ``Transform`` or a dynamic edge's :class:`Snapshot`, from the top down."""
+        key = (target, source, "plan")
+        with self._lock:
+            plan = self._paths.get(key)
+            if plan is None:
+                up_s, up_t = self._resolve(target, source)
+                plan = self._paths[key] = (fold_static(up_s), fold_static(up_t))
+            return (
+                [x if type(x) is Transform else x.snapshot() for x in plan[0]],
+                [x if type(x) is Transform else x.snapshot() for x in plan[1]],
+            )
+
     # -- lookups -------------------------------------------------------------------
     def get(
         self,
@@ -364,12 +388,14 @@ class FrameGraph:
             return A @ B if not with_covariance else A.compose(B)
         if source_at is not None:
             raise ValueError("source_at= needs fixed=, the frame that links the two times")
-        up_s, up_t = self._snap(str(target), str(source))
-        q, shape = _times(at, up_s + up_t)
         if with_covariance:
             from .uncertain import path_covariance
 
+            up_s, up_t = self._snap(str(target), str(source))
+            q, shape = _times(at, up_s + up_t)
             return path_covariance(up_s, up_t, q, shape, interpolation, extrapolate)
+        up_s, up_t = self._planned(str(target), str(source))
+        q, shape = _times(at, [x for x in up_s + up_t if type(x) is not Transform])
         T = compose_path(up_s, up_t, q, interpolation, extrapolate)
         return shaped(T, shape)
 
@@ -403,6 +429,7 @@ class FrameGraph:
         q, shape = _times(at, up_s + up_t)
         if q is None:
             return np.zeros(shape + (6,))
+        q = np.reshape(q, -1)
         V, T = body_twist_path(up_s, up_t, q, interpolation, extrapolate)
         if frame == "world":
             V = np.einsum("...ij,...j->...i", np.asarray(T.adjoint()), V)
@@ -456,7 +483,12 @@ def _times(at, snaps):
     """The query times as a flat float64 array (or None: all static) and the shape."""
     if at is None:
         latest = latest_common_time(snaps)
-        return (None, ()) if latest is None else (np.array([latest]), ())
+        return (None, ()) if latest is None else (latest, ())
+    if type(at) is float or isinstance(at, (int, np.floating, np.integer)):
+        at = float(at)  # one time: the lookup works on Python floats
+        if at != at or at in (np.inf, -np.inf):
+            raise ValueError(f"at: times must be finite, got {at!r}")
+        return (None if all(s.t is None for s in snaps) else at), ()
     q = np.asarray(at, dtype=np.float64)
     shape = q.shape
     if not all(np.isfinite(q.reshape(-1))):

@@ -15,6 +15,7 @@ import numpy as np
 from ...errors import ExtrapolationError
 from ...objects import registry
 from ...objects.transform import Transform
+from .buffer import wrap_pq
 
 __all__ = ["latest_common_time", "chain", "compose_path", "body_twist_path", "shaped"]
 
@@ -50,17 +51,41 @@ def latest_common_time(snaps):
 def _edge(snap, q, interpolation, extrapolate, want_cov):
     """``parent_T_child`` of one edge at ``q`` (None: a single static pose)."""
     if snap.t is None:
-        T = _static(snap)
+        T = snap.pose
         cov = snap.cov[0] if (want_cov and snap.cov is not None) else None
         return T, cov
-    q = snap.check(q, extrapolate)
-    return snap.at(q, interpolation, want_cov)
+    if type(q) is float:
+        return snap.at_one(snap.check_one(q, extrapolate), interpolation, want_cov)
+    return snap.at(snap.check(q, extrapolate), interpolation, want_cov)
 
 
-def _static(snap):
-    from .buffer import wrap_pq
+def fold_static(up):
+    r"""The edges of ``up`` from the top down, each run of static edges replaced by
+    the product of its poses (one ``Transform``); dynamic edges stay
+    :class:`~rigidkit.applications.frames.buffer.EdgeBuffer`\ s."""
+    items, run = [], None
+    for edge in reversed(up):
+        if edge.static:
+            pose = edge.snapshot().pose
+            run = pose if run is None else run @ pose
+            continue
+        if run is not None:
+            items.append(run)
+            run = None
+        items.append(edge)
+    if run is not None:
+        items.append(run)
+    return tuple(items)
 
-    return wrap_pq(snap.pq[0])
+
+def _planned_chain(items, q, interpolation, extrapolate):
+    """``A_T_frame`` from :func:`fold_static`'s items (snapshots taken), or None."""
+    T = None
+    for it in items:
+        if type(it) is not Transform:
+            it = _edge(it, q, interpolation, extrapolate, False)[0]
+        T = it if T is None else T @ it
+    return T
 
 
 def chain(up, q, interpolation, extrapolate, want_cov=False):
@@ -76,10 +101,11 @@ def chain(up, q, interpolation, extrapolate, want_cov=False):
     return T, parts
 
 
-def compose_path(up_s, up_t, q, interpolation, extrapolate):
-    """``target_T_source`` at times ``q`` (an (M,) array, or None for static paths)."""
-    A_T_s, _ = chain(up_s, q, interpolation, extrapolate)
-    A_T_t, _ = chain(up_t, q, interpolation, extrapolate)
+def compose_path(items_s, items_t, q, interpolation, extrapolate):
+    """``target_T_source`` at times ``q`` (an (M,) array, a float, or None for
+    static paths), from the two chains' :func:`fold_static` items."""
+    A_T_s = _planned_chain(items_s, q, interpolation, extrapolate)
+    A_T_t = _planned_chain(items_t, q, interpolation, extrapolate)
     if A_T_t is None:
         return A_T_s if A_T_s is not None else Transform()
     if A_T_s is None:
@@ -124,8 +150,6 @@ def _act(M, v):
 
 def _moving_edge(s, q, interpolation, extrapolate):
     """An edge's pose at ``q`` as a batch (M,) and its body twist (M, 6)."""
-    from .buffer import wrap_pq
-
     if s.t is None:
         E = wrap_pq(np.broadcast_to(s.pq[0], q.shape + (7,)).copy())
         return E, np.zeros(q.shape + (6,))
@@ -136,8 +160,6 @@ def _moving_edge(s, q, interpolation, extrapolate):
 
 def shaped(T, shape):
     """``T`` (shape (M,) of a flat query, or one pose) in the query's shape."""
-    from .buffer import wrap_pq
-
     if T.single:
         if shape:  # an all-static path asked at many times: the one pose, broadcast
             return wrap_pq(np.broadcast_to(registry.stored(T), shape + (7,)).copy())
