@@ -106,9 +106,14 @@ def test_second_parent_and_cycle_rejected(robot):
         g.add("a", "a", rk.Transform())
     with pytest.raises(ValueError, match="update_static"):
         g.add("base", "arm", rk.Transform())
+    before = g.get("odom", "camera", at=2.0)  # caches the path's composed static run
     new = rk.Transform(translation=[0.0, 0.0, 9.0])
     g.update_static("base", "arm", new)
     assert np.array_equal(g.get("base", "arm").translation, [0.0, 0.0, 9.0])
+    after = g.get("odom", "camera", at=2.0)
+    want = g.get("odom", "base", at=2.0) @ new @ g.get("arm", "camera")
+    np.testing.assert_allclose(after.as_matrix(), want.as_matrix(), atol=1e-14)
+    assert not np.allclose(after.as_matrix(), before.as_matrix())
 
 
 # -- lookups ----------------------------------------------------------------------------
@@ -195,6 +200,11 @@ def test_extrapolation_errors(robot):
     np.testing.assert_allclose(
         clamp.as_matrix(), g.get("map", "odom", at=[t0, t1]).as_matrix(), atol=0
     )
+    for t, end in ((t0 - 1.0, t0), (t1 + 1.0, t1)):  # one time: its own path
+        np.testing.assert_array_equal(
+            g.get("map", "odom", at=t, extrapolate="clamp").as_matrix(),
+            g.get("map", "odom", at=end).as_matrix(),
+        )
     hold = g.get("map", "odom", at=t1 + 1.0, extrapolate="hold")
     np.testing.assert_allclose(hold.as_matrix(), g.get("map", "odom", at=t1).as_matrix())
     with pytest.raises(rk.ExtrapolationError, match="past"):
