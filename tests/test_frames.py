@@ -389,3 +389,39 @@ def test_text_and_dot(robot):
     assert dot.startswith("digraph FrameGraph {") and dot.endswith("}")
     assert '"arm" -> "camera" [label="static", style=dashed];' in dot
     assert dot.count("->") == 5
+
+
+def test_readme_frames_example():
+    """The README's robot: the block runs, and its numbers agree with scipy's matrix
+    exponential of the base's motion composed with the camera mount by hand."""
+    import pathlib
+    import re
+
+    from scipy.linalg import expm
+
+    readme = pathlib.Path(__file__).resolve().parents[1] / "README.md"
+    (block,) = [
+        b
+        for b in re.findall(r"```python\n(.*?)```", readme.read_text(), re.S)
+        if "rk.FrameGraph(" in b
+    ]
+    ns: dict = {}
+    exec(block, ns)
+
+    def map_T_camera(t):
+        xi = t * np.array([1.0, 0, 0, 0, 0, 0.5])
+        hat = np.zeros((4, 4))
+        hat[:3, 3] = xi[:3]
+        hat[1, 0], hat[0, 1] = xi[5], -xi[5]
+        mount = np.eye(4)
+        mount[:3, :3] = [[0.0, 0, 1], [-1, 0, 0], [0, -1, 0]]
+        mount[:3, 3] = [0.3, 0, 1.2]
+        return expm(hat) @ mount
+
+    now = ns["now"]
+    p = np.r_[ns["p_camera"], 1.0]
+    then = map_T_camera(now - 0.2)
+    np.testing.assert_allclose(ns["p_map"], (then @ p)[:3], atol=1e-9)
+    want = np.linalg.solve(map_T_camera(now), then @ p)[:3]
+    np.testing.assert_allclose(ns["p_camera_now"], want, atol=1e-9)
+    assert ns["camera_track"].shape == (1000, 3)
