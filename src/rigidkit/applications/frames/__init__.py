@@ -6,7 +6,8 @@ over whole arrays of stamps. :class:`UncertainTransform` is a pose with the
 covariance of a perturbation on the group, propagated through compositions.
 """
 
-from .graph import EdgeInfo, FrameGraph
+from .graph import FrameGraph
+from .tree import EdgeInfo
 from .uncertain import UncertainTransform
 
 __all__ = ["FrameGraph", "EdgeInfo", "UncertainTransform"]

@@ -2,9 +2,6 @@
 
 from __future__ import annotations
 
-import difflib
-from typing import NamedTuple
-
 import numpy as np
 
 from ..._engine import Lock
@@ -20,21 +17,12 @@ from .lookup import (
     body_twist_path,
     compose_path,
     fold_static,
-    latest_common_time,
+    query_times,
     shaped,
 )
+from .tree import check_new_edge, check_parent, info, unknown, up
 
-__all__ = ["FrameGraph", "EdgeInfo"]
-
-
-class EdgeInfo(NamedTuple):
-    """One edge of a :class:`FrameGraph`, as :attr:`FrameGraph.edges` lists it."""
-
-    parent: str
-    child: str
-    kind: str  #: "static" or "dynamic"
-    range: tuple | None  #: (first, last) stamp of a dynamic edge, None if static
-    count: int  #: samples held (1 for a static edge)
+__all__ = ["FrameGraph"]
 
 
 class FrameGraph:
@@ -134,7 +122,7 @@ class FrameGraph:
                     )
                 )
                 return
-            self._check_parent(edge, parent, child)
+            check_parent(edge, parent, child)
             if edge.static or t is None:
                 kind = "static" if edge.static else "dynamic"
                 hint = (
@@ -147,7 +135,15 @@ class FrameGraph:
             edge.insert(t, pq, cov)
 
     def update_static(self, parent, child, parent_T_child, *, cov=None):
-        """Replace the pose of the static edge ``parent -> child`` (added if absent)."""
+        """Replace the pose of the static edge ``parent -> child`` (added if absent).
+
+        >>> import rigidkit as rk
+        >>> graph = rk.FrameGraph()
+        >>> graph.add("base", "camera", rk.Transform(translation=[0.0, 0, 1.0]))
+        >>> graph.update_static("base", "camera", rk.Transform(translation=[0.0, 0, 1.2]))
+        >>> graph.get("base", "camera").translation
+        array([0. , 0. , 1.2])
+        """
         _, pq, cov = as_samples(parent_T_child, None, cov)
         parent, child = str(parent), str(child)
         with self._lock:
@@ -159,19 +155,28 @@ class FrameGraph:
                     f"edge {edge.parent!r} -> {child!r} is dynamic, not static"
                 )
             else:
-                self._check_parent(edge, parent, child)
+                check_parent(edge, parent, child)
                 edge.set_static(pq, cov)
                 self._paths.clear()  # the plans hold composed static poses
                 return
         self.add(parent, child, parent_T_child, cov=cov)
 
     def remove(self, child):
-        """Remove the edge from ``child`` to its parent (``child`` keeps its subtree)."""
+        """Remove the edge from ``child`` to its parent (``child`` keeps its subtree).
+
+        >>> import rigidkit as rk
+        >>> graph = rk.FrameGraph()
+        >>> graph.add("map", "base", rk.Transform())
+        >>> graph.add("base", "camera", rk.Transform())
+        >>> graph.remove("base")
+        >>> graph.parent("base"), graph.children("base"), graph.frames
+        (None, ['camera'], ['base', 'camera'])
+        """
         child = str(child)
         with self._lock:
             edge = self._edges.pop(child, None)
             if edge is None:
-                raise self._unknown(child, "has no parent edge to remove")
+                raise unknown(self._children, child, "has no parent edge to remove")
             self._children[edge.parent].remove(child)
             for name in (edge.parent, child):
                 if not self._children.get(name) and name not in self._edges:
@@ -182,35 +187,16 @@ class FrameGraph:
         """Add a new edge built elsewhere (``from_json``)."""
         with self._lock:
             if edge.child in self._edges:
-                self._check_parent(self._edges[edge.child], edge.parent, edge.child)
+                check_parent(self._edges[edge.child], edge.parent, edge.child)
                 raise ValueError(f"edge {edge.parent!r} -> {edge.child!r} given twice")
             self._attach_locked(edge)
 
     def _attach_locked(self, edge):
-        self._check_new_edge(edge.parent, edge.child)
+        check_new_edge(self._edges, edge.parent, edge.child)
         self._edges[edge.child] = edge
         self._children.setdefault(edge.parent, []).append(edge.child)
         self._children.setdefault(edge.child, [])
         self._paths.clear()
-
-    def _check_parent(self, edge, parent, child):
-        if edge.parent != parent:
-            raise ConnectivityError(
-                f"frame {child!r} already has parent {edge.parent!r}; cannot also "
-                f"attach it to {parent!r} (a frame has one parent)"
-            )
-
-    def _check_new_edge(self, parent, child):
-        if parent == child:
-            raise ConnectivityError(f"an edge from {parent!r} to itself is a cycle")
-        up = [parent]
-        while up[-1] in self._edges:
-            up.append(self._edges[up[-1]].parent)
-            if up[-1] == child:
-                cycle = " -> ".join([child, *reversed(up[:-1]), child])
-                raise ConnectivityError(
-                    f"edge {parent!r} -> {child!r} would close the cycle {cycle}"
-                )
 
     # -- structure -----------------------------------------------------------------
     @property
@@ -224,7 +210,7 @@ class FrameGraph:
         """Every edge as an :class:`EdgeInfo` (parent, child, kind, range, count)."""
         with self._lock:
             snaps = [e.snapshot() for e in self._edges.values()]
-        return [_info(s) for s in snaps]
+        return [info(s) for s in snaps]
 
     def parent(self, frame):
         """The parent of ``frame``, or None for a root."""
@@ -249,21 +235,7 @@ class FrameGraph:
 
     def _known(self, frame):
         if frame not in self._children:
-            raise self._unknown(frame, "is not a frame of this graph")
-
-    def _unknown(self, frame, what):
-        close = difflib.get_close_matches(frame, list(self._children), n=3, cutoff=0.5)
-        hint = f"; closest: {', '.join(map(repr, close))}" if close else ""
-        known = f" (frames: {len(self._children)})" if not close else ""
-        return LookupError(f"{frame!r} {what}{hint}{known}")
-
-    def _up(self, frame):
-        chain_ = []
-        while frame in self._edges:
-            edge = self._edges[frame]
-            chain_.append(edge)
-            frame = edge.parent
-        return chain_, frame
+            raise unknown(self._children, frame, "is not a frame of this graph")
 
     def _resolve(self, target, source):
         """Edges from ``source`` and from ``target`` up to their common ancestor.
@@ -276,8 +248,8 @@ class FrameGraph:
             return found
         self._known(target)
         self._known(source)
-        up_s, root_s = self._up(source)
-        up_t, root_t = self._up(target)
+        up_s, root_s = up(self._edges, source)
+        up_t, root_t = up(self._edges, target)
         if root_s != root_t:
             raise ConnectivityError(
                 f"no path from {source!r} to {target!r}: {source!r} is in the tree "
@@ -366,6 +338,26 @@ class FrameGraph:
             The two frames lie in different trees.
         ExtrapolationError
             A time outside an edge's data (``.edge``, ``.range``, ``.direction``).
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import rigidkit as rk
+        >>> graph = rk.FrameGraph()
+        >>> graph.add("odom", "base", rk.Transform(translation=[[0.0, 0, 0], [2.0, 0, 0]]),
+        ...           stamps=[0.0, 1.0])
+        >>> graph.get("base", "odom", at=[0.25, 0.5]).translation   # base_T_odom
+        array([[-0.5, -0. , -0. ],
+               [-1. , -0. , -0. ]])
+        >>> graph.get("odom", "base").translation                   # the latest: t = 1
+        array([2., 0., 0.])
+        >>> try:
+        ...     graph.get("odom", "base", at=1.5)
+        ... except rk.ExtrapolationError as err:
+        ...     print(err.direction, err.range)
+        future (0.0, 1.0)
+        >>> graph.get("odom", "base", at=1.5, extrapolate="hold").translation
+        array([2., 0., 0.])
         """
         check_options(interpolation, extrapolate)
         if fixed is not None:
@@ -392,10 +384,10 @@ class FrameGraph:
             from .uncertain import path_covariance
 
             up_s, up_t = self._snap(str(target), str(source))
-            q, shape = _times(at, up_s + up_t)
+            q, shape = query_times(at, up_s + up_t)
             return path_covariance(up_s, up_t, q, shape, interpolation, extrapolate)
         up_s, up_t = self._planned(str(target), str(source))
-        q, shape = _times(at, [x for x in up_s + up_t if type(x) is not Transform])
+        q, shape = query_times(at, [x for x in up_s + up_t if type(x) is not Transform])
         T = compose_path(up_s, up_t, q, interpolation, extrapolate)
         return shaped(T, shape)
 
@@ -404,6 +396,12 @@ class FrameGraph:
 
         ``options`` are those of :meth:`get`; the reason is the message of the
         error :meth:`get` would raise.
+
+        >>> import rigidkit as rk
+        >>> graph = rk.FrameGraph()
+        >>> graph.add("map", "odom", rk.Transform())
+        >>> graph.can_transform("map", "odm")
+        (False, "'odm' is not a frame of this graph; closest: 'odom'")
         """
         try:
             self.get(target, source, at, **options)
@@ -421,12 +419,21 @@ class FrameGraph:
         there): ``frame="body"`` gives ``vee(T^-1 dT/dt)`` (in ``source`` axes),
         ``"world"`` gives ``vee(dT/dt T^-1)`` (in ``target`` axes), the
         definitions of :func:`rigidkit.kinematics.twist_from_samples`.
+
+        >>> import numpy as np
+        >>> import rigidkit as rk
+        >>> graph = rk.FrameGraph()
+        >>> turning = rk.Transform.exp([[0.0, 0, 0, 0, 0, 0], [1.0, 0, 0, 0, 0, 0.5]])
+        >>> graph.add("odom", "base", turning, stamps=[0.0, 1.0])
+        >>> V = graph.velocity("odom", "base", 0.5, frame="body", interpolation="screw")
+        >>> np.round(V, 12) + 0.0
+        array([1. , 0. , 0. , 0. , 0. , 0.5])
         """
         if frame not in ("body", "world"):
             raise FrameKeywordError(f"frame must be 'world' or 'body', got {frame!r}")
         check_options(interpolation, extrapolate)
         up_s, up_t = self._snap(str(target), str(source))
-        q, shape = _times(at, up_s + up_t)
+        q, shape = query_times(at, up_s + up_t)
         if q is None:
             return np.zeros(shape + (6,))
         q = np.reshape(q, -1)
@@ -471,28 +478,3 @@ class FrameGraph:
             snaps = {c: e.snapshot() for c, e in self._edges.items()}
             children = {f: list(c) for f, c in self._children.items()}
         return snaps, children
-
-
-def _info(s):
-    if s.t is None:
-        return EdgeInfo(s.parent, s.child, "static", None, 1)
-    return EdgeInfo(s.parent, s.child, "dynamic", (float(s.t[0]), float(s.t[-1])), len(s.t))
-
-
-def _times(at, snaps):
-    """The query times as a flat float64 array (or None: all static) and the shape."""
-    if at is None:
-        latest = latest_common_time(snaps)
-        return (None, ()) if latest is None else (latest, ())
-    if type(at) is float or isinstance(at, (int, np.floating, np.integer)):
-        at = float(at)  # one time: the lookup works on Python floats
-        if at != at or at in (np.inf, -np.inf):
-            raise ValueError(f"at: times must be finite, got {at!r}")
-        return (None if all(s.t is None for s in snaps) else at), ()
-    q = np.asarray(at, dtype=np.float64)
-    shape = q.shape
-    if not all(np.isfinite(q.reshape(-1))):
-        raise ValueError(f"at: times must be finite, got {at!r}")
-    if all(s.t is None for s in snaps):
-        return None, shape
-    return q.reshape(-1), shape

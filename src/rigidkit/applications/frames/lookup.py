@@ -10,6 +10,8 @@ inverse, on whole batches of stamps at once.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ...errors import ExtrapolationError
@@ -17,7 +19,14 @@ from ...objects import registry
 from ...objects.transform import Transform
 from .buffer import wrap_pq
 
-__all__ = ["latest_common_time", "chain", "compose_path", "body_twist_path", "shaped"]
+__all__ = [
+    "query_times",
+    "latest_common_time",
+    "chain",
+    "compose_path",
+    "body_twist_path",
+    "shaped",
+]
 
 
 def latest_common_time(snaps):
@@ -165,3 +174,22 @@ def shaped(T, shape):
             return wrap_pq(np.broadcast_to(registry.stored(T), shape + (7,)).copy())
         return T
     return T.reshape(shape) if shape != T.shape else T
+
+
+def query_times(at, snaps):
+    """The query times as a flat float64 array (or None: all static) and the shape."""
+    if at is None:
+        latest = latest_common_time(snaps)
+        return (None, ()) if latest is None else (latest, ())
+    if type(at) is float or isinstance(at, (int, np.floating, np.integer)):
+        at = float(at)  # one time: the lookup works on Python floats
+        if not math.isfinite(at):
+            raise ValueError(f"at: times must be finite, got {at!r}")
+        return (None if all(s.t is None for s in snaps) else at), ()
+    q = np.asarray(at, dtype=np.float64)
+    shape = q.shape
+    if not np.isfinite(q).all():
+        raise ValueError(f"at: times must be finite, got {at!r}")
+    if all(s.t is None for s in snaps):
+        return None, shape
+    return q.reshape(-1), shape
