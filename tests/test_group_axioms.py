@@ -101,12 +101,14 @@ def scale_of(tau) -> np.ndarray:
 
 
 def act(M, p, point_dim):
-    """The action of matrices on points: linear, or homogeneous ``[p; 1]``."""
+    """The action of matrices on points: linear, or homogeneous ``[p; 1]`` (``[p; 0;
+    1]`` for SE_2(3)'s 5x5 matrices, whose 4th column, the velocity, moves no point)."""
     if M.shape[-1] == point_dim:
         return np.einsum("...ij,...j->...i", M, p)
-    ph = np.concatenate([p, np.ones(p.shape[:-1] + (1,))], axis=-1)
-    q = np.einsum("...ij,...j->...i", M, ph)
-    return q[..., :point_dim] / q[..., point_dim:]
+    pad = np.zeros(p.shape[:-1] + (M.shape[-1] - point_dim,))
+    pad[..., -1] = 1.0
+    q = np.einsum("...ij,...j->...i", M, np.concatenate([p, pad], axis=-1))
+    return q[..., :point_dim] / q[..., -1:]
 
 
 def eye(G):

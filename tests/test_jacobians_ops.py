@@ -163,7 +163,7 @@ def _apply(M, p):
     d = p.shape[-1]
     if M.shape[-1] == d:
         return M @ p
-    return M[:d, :d] @ p + M[:d, d]
+    return M[:d, :d] @ p + M[:d, -1]  # the last column (SE_2(3): its 5th, the position)
 
 
 OPS = {

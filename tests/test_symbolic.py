@@ -39,6 +39,10 @@ def _se3_vee(M):
     return [M[0, 3], M[1, 3], M[2, 3], *_so3_vee(M)]
 
 
+def _se23_vee(M):
+    return [M[0, 3], M[1, 3], M[2, 3], M[0, 4], M[1, 4], M[2, 4], *_so3_vee(M)]
+
+
 def _se2_vee(M):
     return [M[0, 2], M[1, 2], M[1, 0]]
 
@@ -49,6 +53,12 @@ REFERENCES = {
     "so3": (3, lambda x: S.matrix_from_rotvec(x), _so3_vee, S.so3),
     "se3": (6, lambda x: S.se3.matrix_from_pose(S.se3.pose_from_twist(x)), _se3_vee, S.se3),
     "se2": (3, lambda x: S.se2.matrix_from_pose(S.se2.pose_from_twist(x)), _se2_vee, S.se2),
+    "se23": (
+        9,
+        lambda x: S.se23.matrix_from_extpose(S.se23.extpose_from_tangent(x)),
+        _se23_vee,
+        S.se23,
+    ),
 }
 
 

@@ -44,7 +44,8 @@ def action_generator(hat, dof, point_dim, points):
 
     For a group of matrices ``n x n`` acting on points of dimension ``d`` (``n = d``
     for rotations, ``n = d + 1`` for homogeneous transforms, whose points are ``[p;
-    1]``), ``G(p)`` is the derivative of ``exp(tau) p`` at ``tau = 0``; for SE(3),
+    1]``; ``[p; 0; 1]`` for SE_2(3)), ``G(p)`` is the derivative of ``exp(tau) p``
+    at ``tau = 0``; for SE(3),
     ``G(p) = [I, -hat(p)]``, for Sim(3) ``[I, -hat(p), p]``.
 
     Parameters
@@ -65,7 +66,10 @@ def action_generator(hat, dof, point_dim, points):
     H = xp.asarray(rows, dtype=points.dtype, device=device_of(points))
     if rows.shape[-1] > point_dim:
         # (p is finite; the torch adapter has no ones_like of a slice's shape)
-        points = xp.concat([points, points[..., :1] * 0.0 + 1.0], axis=-1)
+        zero = points[..., :1] * 0.0
+        # ``[p; 1]``, or ``[p; 0; 1]`` for SE_2(3), whose velocity column moves no point
+        pad = [zero] * (rows.shape[-1] - point_dim - 1)
+        points = xp.concat([points, *pad, zero + 1.0], axis=-1)
     return xp.matmul(H, points[..., None, :, None])[..., 0]
 
 

@@ -33,7 +33,7 @@ quaternion ``(..., 4)`` for a ``Rotation``, a pose ``(..., 7)`` for a
 >>> spec.algebra.__name__, spec.part("rotation"), spec.rate
 ('rigidkit.functional.so3', slice(0, 3, None), 'angular velocity')
 >>> [cls.__name__ for cls in registry.groups(lie=True)]
-['Rotation2D', 'Transform2D', 'Rotation', 'Transform', 'Similarity']
+['ExtendedPose', 'Rotation2D', 'Transform2D', 'Rotation', 'Transform', 'Similarity']
 """
 
 from __future__ import annotations
