@@ -129,7 +129,15 @@ class UncertainTransform:
     def inv(self):
         """``mean^-1`` with ``cov' = J cov J^T``, ``J = -Ad(mean)`` (right) or
         ``-Ad(mean)^-1`` (left): exact, the inverse of a perturbed pose being a
-        perturbed inverse."""
+        perturbed inverse.
+
+        >>> import numpy as np
+        >>> import rigidkit as rk
+        >>> A_T_B = rk.UncertainTransform(rk.Transform(translation=[2.0, 0, 0]),
+        ...                               np.diag([0.0, 0, 0, 0, 0, 0.01]))   # yaw only
+        >>> np.round(np.diag(A_T_B.inv().cov), 6)    # B_T_A: the yaw swings A's origin
+        array([0.  , 0.04, 0.  , 0.  , 0.  , 0.01])
+        """
         M, J = _jac.inv(self._mean, side=self._side)
         return UncertainTransform(M, _sandwich(J, self._cov), self._side)
 
@@ -155,6 +163,18 @@ class UncertainTransform:
         -------
         UncertainTransform
             On ``self.side``.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import rigidkit as rk
+        >>> X = rk.UncertainTransform(rk.Transform(), np.diag([0.0, 0, 0, 0, 0, 0.09]))
+        >>> Y = rk.UncertainTransform(rk.Transform(translation=[1.0, 0, 0]),
+        ...                           np.diag([0.09, 0, 0, 0, 0, 0]))
+        >>> np.round(np.diag(X.compose(Y).cov)[:2], 5)      # x of Y, y from X's yaw
+        array([0.09, 0.09])
+        >>> np.round(np.diag(X.compose(Y, order=4).cov)[:2], 5)   # Y's x turned by yaw
+        array([0.08865, 0.09202])
         """
         if not isinstance(other, UncertainTransform):
             raise TypeError(
@@ -182,7 +202,17 @@ class UncertainTransform:
 
     def between(self, other):
         """``self^-1 @ other`` (``other`` seen from ``self``) for independent poses,
-        first order with :func:`rigidkit.jacobians.between` on ``self.side``."""
+        first order with :func:`rigidkit.jacobians.between` on ``self.side``.
+
+        >>> import numpy as np
+        >>> import rigidkit as rk
+        >>> W_T_A = rk.UncertainTransform(rk.Transform(), 0.01 * np.eye(6))
+        >>> W_T_B = rk.UncertainTransform(rk.Transform(translation=[1.0, 0, 0]),
+        ...                               0.01 * np.eye(6))
+        >>> A_T_B = W_T_A.between(W_T_B)
+        >>> np.round(np.diag(A_T_B.cov), 6)      # both add, plus A's rotation times 1 m
+        array([0.02, 0.03, 0.03, 0.02, 0.02, 0.02])
+        """
         other = other.to_side(self._side)
         Z, J1, J2 = _jac.between(self._mean, other._mean, side=self._side)
         cov = _sandwich(J1, self._cov) + _sandwich(J2, other._cov)
@@ -199,6 +229,15 @@ class UncertainTransform:
         -------
         point : ndarray, shape (..., 3)
         cov : ndarray, shape (..., 3, 3)
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import rigidkit as rk
+        >>> W_T_C = rk.UncertainTransform(rk.Transform(), np.diag([0.0, 0, 0, 0, 0, 1e-4]))
+        >>> p_W, cov = W_T_C.transform_point([2.0, 0.0, 0.0])
+        >>> np.round(np.diag(cov), 8)             # a yaw of 0.01 rad moves it 2 cm in y
+        array([0.    , 0.0004, 0.    ])
         """
         y, J_T, J_p = _jac.apply(self._mean, point, side=self._side)
         cov = J_T @ self._cov @ _mT(J_T)
