@@ -217,3 +217,27 @@ def test_graph_with_covariance(pair):
         "right",
     )
     assert rel(np.asarray(got.cov), mc) < 0.03
+
+
+def test_torch_inputs_stay_torch(torch, pair):
+    """First-order propagation on torch tensors: torch out, numbers as NumPy's."""
+    X, Y, rng = pair
+    C1, C2 = random_cov(rng, 0.1), random_cov(rng, 0.2)
+    tX = rk.Transform.from_pq(torch.tensor(np.asarray(X.as_pq())))
+    tY = rk.Transform.from_pq(torch.tensor(np.asarray(Y.as_pq())))
+    for side in ("right", "left"):
+        A, B = rk.UncertainTransform(X, C1, side), rk.UncertainTransform(Y, C2, side)
+        tA = rk.UncertainTransform(tX, torch.tensor(C1), side)
+        tB = rk.UncertainTransform(tY, torch.tensor(C2), side)
+        for ours, ref in (
+            (tA.compose(tB), A.compose(B)),
+            (tA.inv(), A.inv()),
+            (tA.between(tB), A.between(B)),
+        ):
+            assert isinstance(ours.cov, torch.Tensor)
+            np.testing.assert_allclose(ours.cov.numpy(), ref.cov, atol=1e-12)
+        y, cov = tA.transform_point(torch.tensor([0.5, -1.0, 2.0], dtype=torch.float64))
+        assert isinstance(cov, torch.Tensor)
+        np.testing.assert_allclose(
+            cov.numpy(), A.transform_point(np.array([0.5, -1.0, 2.0]))[1], atol=1e-12
+        )
