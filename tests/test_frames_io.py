@@ -221,3 +221,34 @@ def test_missing_rosbags_names_the_extra(monkeypatch, tmp_path):
     monkeypatch.setitem(sys.modules, "rosbags.highlevel", None)
     with pytest.raises(ImportError, match=r"rigidkit\[ros\]"):
         rk.io.read_tf(tmp_path / "x.bag")
+
+
+@pytest.mark.parametrize("kind", ["ros1", "mcap"])
+def test_read_tf_broken_tree_and_ros1_tf_message(tmp_path, kind):
+    """A frame with two parents is an error naming the recording and both parents;
+    ROS 1's older tf/tfMessage is read like tf2's message."""
+    rng = np.random.default_rng(9)
+    w, m = writer(kind, tmp_path)
+    msgtype = "tf2_msgs/msg/TFMessage"
+    if kind == "ros1":
+        from rosbags.typesys import get_types_from_msg
+
+        m.ts.register(
+            get_types_from_msg(
+                "geometry_msgs/TransformStamped[] transforms", "tf/msg/tfMessage"
+            )
+        )
+        msgtype = "tf/msg/tfMessage"
+    with w:
+        tf = w.add_connection("/tf", msgtype, typestore=m.ts)
+        TF = m.T[msgtype]
+        for k, parent in enumerate(["map", "odom"]):
+            msg = TF(
+                transforms=[
+                    m.transform_stamped(T0_SEC + k, 0, parent, "base", random_pq(1, rng)[0])
+                ]
+            )
+            w.write(tf, 10**9 * (T0_SEC + k), m.serialize(msg))
+    src = bag_path(kind, tmp_path, kind == "mcap")
+    with pytest.raises(rk.ConnectivityError, match=r"rec.*'base'.*'map'.*'odom'"):
+        rk.io.read_tf(src)

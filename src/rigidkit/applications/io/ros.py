@@ -101,7 +101,10 @@ def read_tf(path, topics=("/tf", "/tf_static"), *, max_duration=None, max_sample
     ImportError
         ``rosbags`` is not installed (the ``ros`` extra).
     ConnectivityError
-        The recording gives a frame two parents (the message names both).
+        The recording gives a frame two parents (the message names the file and
+        both parents).
+    ValueError
+        An edge both static (``/tf_static``) and dynamic.
     """
     from ..frames import FrameGraph  # a sibling application, loaded on use
 
@@ -122,10 +125,13 @@ def read_tf(path, topics=("/tf", "/tf_static"), *, max_duration=None, max_sample
                     dynamic[edge][0].append(_stamp(tf.header))
                     dynamic[edge][1].append(pq)
     graph = FrameGraph(max_duration=max_duration, max_samples=max_samples)
-    for (parent, child), pq in static.items():
-        graph.add(parent, child, np.array(pq))
-    for (parent, child), (stamps, rows) in dynamic.items():
-        graph.add(parent, child, np.array(rows), stamps=np.array(stamps))
+    try:
+        for (parent, child), pq in static.items():
+            graph.add(parent, child, np.array(pq))
+        for (parent, child), (stamps, rows) in dynamic.items():
+            graph.add(parent, child, np.array(rows), stamps=np.array(stamps))
+    except ValueError as err:  # a tree the recording breaks: say which recording
+        raise type(err)(f"{path}: {err}") from err
     return graph
 
 
