@@ -429,3 +429,17 @@ def test_kitti_errors_of_a_scaled_estimate():
         assert t == pytest.approx(2.0 * (L + 0.5) / L, rel=1e-12)
         assert rot == 0.0
         assert count == len(range(0, len(x), 10)) - sum(x[::10] + L >= x[-1])
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 4, 7, 10, 1000, 1001])
+def test_statistics_equal_numpy(n):
+    e = np.abs(np.random.default_rng(n).normal(size=n))
+    s = rk.trajectory.statistics(e)
+    assert s["median"] == np.median(e) and s["min"] == e.min() and s["max"] == e.max()
+    np.testing.assert_allclose(
+        [s["mean"], s["std"], s["sse"], s["rmse"]],
+        [e.mean(), e.std(), (e**2).sum(), np.sqrt((e**2).mean())],
+        rtol=1e-14,
+    )
+    batch = rk.trajectory.statistics(np.stack([e, 2 * e]))
+    np.testing.assert_allclose(batch["rmse"], [s["rmse"], 2 * s["rmse"]], rtol=1e-14)
