@@ -16,6 +16,7 @@ import numpy as np
 
 from ...errors import ExtrapolationError, ShapeError, TimestampError
 from ...objects import registry
+from ...objects.rotation import Rotation
 from ...objects.transform import Transform
 from ..interpolation import slerp
 
@@ -25,6 +26,7 @@ __all__ = ["EdgeBuffer", "Snapshot", "as_samples", "wrap_pq"]
 #: in this package) as a ``Transform`` without re-validation:
 #: every stored row went through ``Transform.from_pq`` (normalised) on insertion.
 wrap_pq = registry.spec(Transform).wrap
+wrap_quat = registry.spec(Rotation).wrap
 
 _EXTRAPOLATE = (None, "clamp", "hold")
 _INTERPOLATION = ("decoupled", "screw")
@@ -88,10 +90,11 @@ class Snapshot:
     or None; ``parent`` and ``child`` name the edge for error messages.
     """
 
-    __slots__ = ("parent", "child", "t", "pq", "cov", "pose")
+    __slots__ = ("parent", "child", "t", "pq", "cov", "pose", "_inc")
 
     def __init__(self, parent, child, t, pq, cov):
         self.parent, self.child, self.t, self.pq, self.cov = parent, child, t, pq, cov
+        self._inc = {}
         #: a static edge's pose, made once (snapshots are cached by their buffer)
         self.pose = wrap_pq(pq[0]) if t is None else None
 
@@ -197,14 +200,65 @@ class Snapshot:
             if want_cov and self.cov is not None:
                 cov = np.broadcast_to(self.cov[0], q.shape + (6, 6)).copy()
             return T, cov
-        T = slerp(
-            wrap_pq(pq[i]), wrap_pq(pq[i + 1]), a, decoupled=interpolation == "decoupled"
-        )
+        if 4 * q.shape[0] >= pq.shape[0]:
+            T = self._from_increments(i, a, interpolation)
+        else:
+            T = slerp(
+                wrap_pq(pq[i]),
+                wrap_pq(pq[i + 1]),
+                a,
+                decoupled=interpolation == "decoupled",
+            )
         cov = None
         if want_cov and self.cov is not None:
             w = a[..., None, None]
             cov = (1.0 - w) * self.cov[i] + w * self.cov[i + 1]
         return T, cov
+
+    def increments(self, interpolation):
+        """Each segment's tangent, computed once per snapshot: ``log(T_i^-1 T_{i+1})``
+        (N - 1, 6) for ``"screw"``, ``log(R_i^-1 R_{i+1})`` (N - 1, 3) for
+        ``"decoupled"``; ``"parts"``: the quaternions (N, 4) and positions (N, 3),
+        each contiguous."""
+        inc = self._inc.get(interpolation)
+        if inc is None:
+            T = wrap_pq(self.pq)
+            if interpolation == "parts":  # contiguous quaternions and positions
+                inc = (
+                    np.ascontiguousarray(self.pq[:, :4]),
+                    np.ascontiguousarray(self.pq[:, 4:]),
+                )
+            elif interpolation == "screw":
+                inc = np.asarray((T[:-1].inv() @ T[1:]).log())
+            else:
+                R = T.rotation
+                inc = np.asarray((R[:-1].inv() @ R[1:]).as_rotvec())
+            self._inc[interpolation] = inc  # a race computes the same array twice
+        return inc
+
+    def _from_increments(self, i, a, interpolation):
+        """The interpolant from :meth:`increments`: ``T_i exp(a xi_i)`` (screw), or
+        ``R_i exp(a phi_i)`` with ``p_i + a (p_{i+1} - p_i)`` (decoupled). The same
+        geodesics as :func:`~rigidkit.slerp`, with the per-segment logarithm
+        taken once instead of at every time: for many times on few segments."""
+        pq = self.pq
+        # np.take: ~4x faster than fancy indexing for rows; the gathered copy of
+        # the increments is scaled in place
+        step = np.take(self.increments(interpolation), i, axis=0)
+        step *= a[:, None]
+        if interpolation == "screw":
+            return wrap_pq(np.take(pq, i, axis=0)) @ Transform.exp(step)
+        quats, points = self.increments("parts")
+        out = np.empty((a.shape[0], 7))
+        rotation = wrap_quat(np.take(quats, i, axis=0)) @ Rotation.from_rotvec(step)
+        out[:, :4] = registry.stored(rotation)
+        p0 = np.take(points, i, axis=0)
+        p = np.take(points, i + 1, axis=0)
+        p -= p0
+        p *= a[:, None]
+        p += p0
+        out[:, 4:] = p
+        return wrap_pq(out)
 
     def body_twist(self, q, interpolation):
         """Body twist ``vee(T^-1 dT/dt)`` of the interpolant at ``q``, shape (M, 6).
