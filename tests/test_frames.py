@@ -134,6 +134,11 @@ def test_get_matches_explicit_composition(robot, interpolation):
     np.testing.assert_allclose(one.as_matrix(), want[3], atol=1e-10)
     grid = g.get("tag", "camera", at=times.reshape(20, 10), interpolation=interpolation)
     assert grid.shape == (20, 10)
+    # few times on many samples take a slerp per time, many take each segment's log
+    # once: the same geodesics
+    few = g.get("tag", "camera", at=times[:5], interpolation=interpolation)
+    np.testing.assert_allclose(few.as_matrix(), want[:5], atol=1e-10)
+    np.testing.assert_allclose(few.as_matrix(), got[:5].as_matrix(), atol=1e-14)
 
 
 def test_exact_at_samples_and_latest_common_time(robot):
