@@ -141,6 +141,23 @@ def test_get_matches_explicit_composition(robot, interpolation):
     np.testing.assert_allclose(few.as_matrix(), got[:5].as_matrix(), atol=1e-14)
 
 
+@pytest.mark.parametrize("decoupled", [True, False])
+def test_interpolation_is_rk_slerp(decoupled):
+    """Between two samples an edge is rk.slerp of them (decoupled=True: tf2's rule)."""
+    rng = np.random.default_rng(8)
+    T = rk.Transform.from_pq(random_pq(2, rng))
+    g = rk.FrameGraph()
+    g.add("a", "b", T, stamps=[1.0, 3.0])
+    a = np.array([0.0, 0.1, 0.5, 0.77, 1.0])
+    want = rk.slerp(T[0], T[1], a, decoupled=decoupled).as_matrix()
+    how = "decoupled" if decoupled else "screw"
+    got = g.get("a", "b", at=1.0 + 2.0 * a, interpolation=how).as_matrix()
+    np.testing.assert_allclose(got, want, atol=1e-14)
+    for k in range(len(a)):
+        one = g.get("a", "b", at=float(1.0 + 2.0 * a[k]), interpolation=how).as_matrix()
+        np.testing.assert_allclose(one, want[k], atol=1e-14)
+
+
 def test_exact_at_samples_and_latest_common_time(robot):
     g, data = robot
     s, pq = data["map", "odom"]
