@@ -90,11 +90,12 @@ class Snapshot:
     or None; ``parent`` and ``child`` name the edge for error messages.
     """
 
-    __slots__ = ("parent", "child", "t", "pq", "cov", "pose", "_inc")
+    __slots__ = ("parent", "child", "t", "pq", "cov", "pose", "_inc", "_last")
 
     def __init__(self, parent, child, t, pq, cov):
         self.parent, self.child, self.t, self.pq, self.cov = parent, child, t, pq, cov
         self._inc = {}
+        self._last = None
         #: a static edge's pose, made once (snapshots are cached by their buffer)
         self.pose = wrap_pq(pq[0]) if t is None else None
 
@@ -116,21 +117,34 @@ class Snapshot:
         return q
 
     def at_one(self, q, interpolation, want_cov=False):
-        """:meth:`at` of one time (a float within range): a single ``Transform``."""
-        t, pq = self.t, self.pq
-        n = t.shape[0]
-        i = min(max(int(t.searchsorted(q, side="right")) - 1, 0), n - 2) if n > 1 else 0
-        t0 = float(t[i])
-        a = 0.0 if n == 1 else (q - t0) / (float(t[i + 1]) - t0)
-        if a == 0.0:  # at a sample (slerp's value at 0 too, without the call)
-            T = wrap_pq(pq[i])
-        else:
-            T = slerp(
-                wrap_pq(pq[i]),
-                wrap_pq(pq[i + 1]),
-                a,
-                decoupled=interpolation == "decoupled",
+        """:meth:`at` of one time (a float within range): a single ``Transform``.
+
+        The last segment used is kept (successive lookups mostly fall in the
+        same one): its index, ends and poses, replaced as a whole (one tuple) so
+        that threads sharing the snapshot each see a consistent segment.
+        """
+        seg = self._last
+        if seg is None or not (seg[1] <= q < seg[2]):
+            t = self.t
+            n = t.shape[0]
+            if n == 1:
+                return wrap_pq(self.pq[0]), (
+                    self.cov[0] if want_cov and self.cov is not None else None
+                )
+            i = min(max(int(t.searchsorted(q, side="right")) - 1, 0), n - 2)
+            seg = self._last = (
+                i,
+                float(t[i]),
+                float(t[i + 1]),
+                wrap_pq(self.pq[i]),
+                wrap_pq(self.pq[i + 1]),
             )
+        i, t0, t1, x0, x1 = seg
+        a = (q - t0) / (t1 - t0)
+        if a == 0.0:  # at a sample (slerp's value at 0 too, without the call)
+            T = x0
+        else:
+            T = slerp(x0, x1, a, decoupled=interpolation == "decoupled")
         cov = None
         if want_cov and self.cov is not None:
             cov = self.cov[i] if a == 0.0 else (1.0 - a) * self.cov[i] + a * self.cov[i + 1]
