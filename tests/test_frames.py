@@ -136,6 +136,10 @@ def test_get_matches_explicit_composition(robot, interpolation):
     assert grid.shape == (20, 10)
     # few times on many samples take a slerp per time, many take each segment's log
     # once: the same geodesics
+    # single lookups in and out of each edge's last segment, in time order and not
+    for k in list(np.argsort(times)[::3]) + list(range(0, 200, 7)):
+        one = g.get("tag", "camera", at=float(times[k]), interpolation=interpolation)
+        np.testing.assert_allclose(one.as_matrix(), want[k], atol=1e-10)
     few = g.get("tag", "camera", at=times[:5], interpolation=interpolation)
     np.testing.assert_allclose(few.as_matrix(), want[:5], atol=1e-10)
     np.testing.assert_allclose(few.as_matrix(), got[:5].as_matrix(), atol=1e-14)
