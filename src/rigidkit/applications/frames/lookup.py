@@ -58,7 +58,8 @@ def latest_common_time(snaps):
 
 
 def _edge(snap, q, interpolation, extrapolate, want_cov):
-    """``parent_T_child`` of one edge at ``q`` (None: a single static pose)."""
+    """``(parent_T_child, cov or None)`` of one edge at ``q``: a float (one pose),
+    an (M,) array (a batch), or None (a static edge's one pose)."""
     if snap.t is None:
         T = snap.pose
         cov = snap.cov[0] if (want_cov and snap.cov is not None) else None
