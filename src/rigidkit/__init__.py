@@ -63,6 +63,7 @@ _LAZY = {
     "align_vectors": ("applications.alignment", "align_vectors"),
     "align_points": ("applications.alignment", "align_points"),
     "kinematics": ("applications.kinematics", None),
+    "inertial": ("applications.inertial", None),
     "jacobians": ("applications.jacobians", None),
     "cli": ("applications.cli", None),
     "geodesic_distance": ("objects.rotation", "geodesic_distance"),
@@ -121,6 +122,7 @@ __all__ = [
     "se23",
     "symbolic",
     "kinematics",
+    "inertial",
     "jacobians",
     # the validation switch (docs/architecture.md, "Validation policy")
     "set_validation",
