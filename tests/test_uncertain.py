@@ -179,6 +179,12 @@ def test_against_gtsam_jacobians(pair):
     want = H1 @ C1[np.ix_(SWAP, SWAP)] @ H1.T + H2 @ C2[np.ix_(SWAP, SWAP)] @ H2.T
     got = rk.UncertainTransform(X, C1).between(rk.UncertainTransform(Y, C2)).cov
     np.testing.assert_allclose(np.asarray(got)[np.ix_(SWAP, SWAP)], want, atol=1e-12)
+    H = np.zeros((6, 6), order="F")
+    pose(X).inverse(H)  # the inverse's covariance: Ad(X), not the identity
+    got = rk.UncertainTransform(X, C1).inv().cov
+    np.testing.assert_allclose(
+        np.asarray(got)[np.ix_(SWAP, SWAP)], H @ C1[np.ix_(SWAP, SWAP)] @ H.T, atol=1e-12
+    )
     Hp, Hq = np.zeros((3, 6), order="F"), np.zeros((3, 3), order="F")
     p = np.array([0.5, -1.0, 2.0])
     pose(X).transformFrom(p, Hp, Hq)
