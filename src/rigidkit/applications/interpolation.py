@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._engine import owned_function
+from .._engine.namespace import device_of, namespace_of
 from .._validate import finite_array, to_numpy
 from ..errors import DegenerateInputError, OutOfRangeError, ShapeError
 from ..functional import interpolation as _fi
@@ -31,8 +32,9 @@ def slerp(a, b, t, *, decoupled=False):
 
     Parameters
     ----------
-    a, b : Rotation or Transform
-        The ends, of one kind; batch shapes broadcast.
+    a, b : Rotation, Transform, or any other Lie group of rigidkit
+        The ends, of one kind; batch shapes broadcast. Groups other than
+        ``Rotation`` and ``Transform`` follow ``a exp(t log(a^-1 b))``.
     t : array_like, shape (...)
         Fractions, broadcasting with the batch: 0 gives ``a`` exactly, 1 gives
         ``b``; outside [0, 1] the geodesic is extended.
@@ -42,7 +44,7 @@ def slerp(a, b, t, *, decoupled=False):
 
     Returns
     -------
-    Rotation or Transform
+    The kind of ``a`` and ``b``
 
     Examples
     --------
@@ -64,10 +66,28 @@ def slerp(a, b, t, *, decoupled=False):
         if decoupled:
             raise TypeError("decoupled= applies to Transform, not Rotation")
         return _wrap_rotation(_fi.quat_slerp_unchecked(stored(a), stored(b), t))
+    spec = registry.spec(type(a))
+    if type(a) is type(b) and spec is not None and spec.algebra is not None:
+        if decoupled:
+            raise TypeError(f"decoupled= applies to Transform, not {type(a).__name__}")
+        return _geodesic(a, b, t)
     raise TypeError(
-        "slerp interpolates two Rotations or two Transforms, got "
-        f"{type(a).__name__} and {type(b).__name__}"
+        "slerp interpolates two elements of one Lie group (Rotation, Transform, "
+        f"Rotation2D, ...), got {type(a).__name__} and {type(b).__name__}"
     )
+
+
+def _geodesic(a, b, t):
+    """``a exp(t log(a^-1 b))`` for any registered Lie group, from its own operations.
+
+    Rotations and transforms have their own kernels (the same curve, with the
+    quaternion's shortest path); every other group (``Rotation2D``,
+    ``Transform2D``, ``Similarity``, ...) takes this, written once.
+    """
+    tau = (a.inv() @ b).log()
+    xp = namespace_of(tau)
+    t = xp.asarray(t, dtype=tau.dtype, device=device_of(tau))
+    return a @ type(a).exp(t[..., None] * tau)
 
 
 # Bound once: each global and attribute lookup is ~30 ns of a ~1 us call.

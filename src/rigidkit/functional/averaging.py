@@ -64,6 +64,8 @@ __all__ = [
     "quat_mean_unchecked",
     "pose_mean",
     "pose_mean_unchecked",
+    "lie_steps",
+    "lie_mean_unchecked",
     "reduce_axes",
 ]
 
@@ -335,25 +337,64 @@ def _karcher(xp, mean, g, w, total, method, tol, max_iter, steps):
     return mean, max_iter
 
 
-def _quat_log_from(mean, q):
-    rel = _kq.quat_multiply(_kq.quat_conjugate(mean[..., None, :]), q)
-    return _krv.rotvec_from_quat(rel)
+def lie_steps(compose, inverse, exp, log):
+    """The Karcher steps ``(log_from, retract)`` of a group from four of its operations.
+
+    ``compose(a, b)``, ``inverse(a)``, ``exp(tau)`` and ``log(a)`` act on the
+    group's stored arrays (``(..., c)``: quaternions, poses, ...) and tangents
+    ``(..., dof)``; they are its kernels, or any functions with their signatures.
+    ``log_from(mean, g)`` is ``log(mean^-1 g_i)`` for ``mean`` (kept, c) and
+    ``g`` (kept, K, c); ``retract(mean, step)`` is ``mean exp(step)``. Every mean
+    of every group iterates these (:func:`lie_mean_unchecked`), so the fixed point
+    ``sum w_i log(mean^-1 g_i) = 0`` is written once.
+
+    >>> from rigidkit.kernels import quaternion as kq, so3 as ks
+    >>> log_from, retract = lie_steps(
+    ...     kq.quat_multiply, kq.quat_conjugate, ks.quat_from_rotvec, ks.rotvec_from_quat
+    ... )
+    >>> q = np.array([[[np.cos(0.1), 0.0, 0.0, np.sin(0.1)]]])  # 0.2 rad about z
+    >>> np.round(log_from(np.array([[1.0, 0.0, 0.0, 0.0]]), q), 12)
+    array([[[0. , 0. , 0.2]]])
+    """
+
+    def log_from(mean, g):
+        return log(compose(inverse(mean[..., None, :]), g))
+
+    def retract(mean, step):
+        return compose(mean, exp(step))
+
+    return log_from, retract
 
 
-def _quat_retract(mean, step):
-    return _kq.quat_multiply(mean, _krv.quat_from_rotvec(step))
+_SO3_STEPS = lie_steps(
+    _kq.quat_multiply, _kq.quat_conjugate, _krv.quat_from_rotvec, _krv.rotvec_from_quat
+)
+_SE3_STEPS = lie_steps(
+    _kse3.pose_compose, _kse3.pose_inv, _kse3.pose_from_twist, _kse3.twist_from_pose
+)
 
 
-def _pose_log_from(mean, p):
-    return _kse3.twist_from_pose(_kse3.pose_compose(_kse3.pose_inv(mean)[..., None, :], p))
+def lie_mean_unchecked(
+    x, weights=None, *, steps, method="geodesic", axis=None, tol=None, max_iter=100
+):
+    """The Karcher mean of elements of any Lie group, stored ``(..., c)``, along batch axes.
 
-
-def _pose_retract(mean, step):
-    return _kse3.pose_compose(mean, _kse3.pose_from_twist(step))
-
-
-_SO3_STEPS = (_quat_log_from, _quat_retract)
-_SE3_STEPS = (_pose_log_from, _pose_retract)
+    ``mu <- mu exp(sum w_i log(mu^-1 x_i) / sum w_i)`` from the first element of
+    each averaged group until the norm of the mean log is below ``tol`` (1e-12, or
+    1e-6 in float32): the weighted Frechet mean of the left-invariant metric,
+    unique for data concentrated enough (Pennec and Arsigny 2012). ``steps`` is
+    the group's ``(log_from, retract)`` (:func:`lie_steps`). Elements are assumed
+    valid (not checked); the weights are validated as in :func:`quat_mean`.
+    Returns ``(mean, iterations)``, ``mean`` of shape (kept batch..., c).
+    """
+    if method != "geodesic":
+        raise ValueError(f"method must be 'geodesic' for this group, got {method!r}")
+    if dask_backend.any_dask(x, weights):
+        fn = functools.partial(lie_mean_unchecked, steps=steps)
+        return _lazy_mean(fn, x, weights, axis, method, tol, max_iter)
+    xp = namespace_of(x)
+    g, w, total = _grouped_weighted(xp, x, weights, axis, "elements")
+    return _karcher(xp, g[..., 0, :], g, w, total, method, tol, max_iter, steps)
 
 
 def quat_mean(quats, weights=None, *, method="chordal", axis=None, tol=None, max_iter=100):

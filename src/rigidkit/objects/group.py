@@ -179,6 +179,42 @@ class LieGroup(Group):
     matrix_size: int
     point_dim: int
 
+    def mean(
+        self, weights=None, *, method="geodesic", axis=None, return_info=False, tol=None
+    ):
+        """The Karcher (geodesic) mean along batch ``axis`` (default all).
+
+        ``mu <- mu exp(sum w_i log(mu^-1 X_i) / sum w_i)``, from the first element,
+        until the norm of the mean log is below ``tol`` (1e-12; 1e-6 in float32):
+        the weighted Frechet mean of the left-invariant metric, unique for data
+        concentrated enough (Pennec and Arsigny 2012). Written once for every
+        group, from its ``inv``, ``@``, ``exp`` and ``log``
+        (:func:`rigidkit.functional.averaging.lie_mean_unchecked`); ``Rotation``
+        and ``Transform`` also have ``method="chordal"`` (their default).
+        ``weights`` (shape (...), >= 0) broadcast with the batch;
+        ``return_info=True`` returns ``(mean, {"iterations": k})``.
+
+        >>> import numpy as np
+        >>> import rigidkit as rk
+        >>> X = rk.Rotation2D.from_angle([0.1, 0.3])
+        >>> round(float(X.mean().angle), 12)
+        0.2
+        """
+        from ..functional.averaging import lie_mean_unchecked, lie_steps
+
+        cls = type(self)
+        wrap = cls._wrap
+        steps = lie_steps(
+            lambda a, b: (wrap(a) @ wrap(b))._data,
+            lambda a: wrap(a).inv()._data,
+            lambda tau: cls.exp(tau)._data,
+            lambda a: wrap(a).log(),
+        )
+        data, k = lie_mean_unchecked(
+            self._data, weights, steps=steps, method=method, axis=axis, tol=tol
+        )
+        return (wrap(data), {"iterations": k}) if return_info else wrap(data)
+
     @classmethod
     @abstractmethod
     def exp(cls, tau): ...
