@@ -1258,3 +1258,180 @@ def test_ambiguous_or_unknown_callees_are_refused(tmp_path):
     """
     with pytest.raises(NameError, match="neither a primitive nor a helper"):
         _load(tmp_path, "rigidkit_test_unknown", unknown)
+
+
+# -- the engine's public surface for the layers above ---------------------------------
+
+
+def _fresh(code, timeout=300):
+    """Run ``code`` in a fresh interpreter; its stdout, after asserting it exited 0."""
+    res = subprocess.run(
+        [sys.executable, "-c", textwrap.dedent(code)],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
+    assert res.returncode == 0, res.stderr[-3000:]
+    return res.stdout.strip()
+
+
+def test_every_compile_runs_on_one_background_thread():
+    """Kernel loops, the chordal mean's host loop and the integration scan are all
+    compiled on the engine's one thread: no other thread is ever started."""
+    if not numba_backend.available():
+        pytest.skip("needs numba")
+    out = _fresh(
+        """
+        import sys, threading
+        import numpy as np
+        import rigidkit as rk
+        from rigidkit._engine import drain
+        from rigidkit.functional import averaging
+        names = set()
+        real = threading.Thread.start
+        def start(self):
+            names.add(self.name)
+            return real(self)
+        threading.Thread.start = start
+        R = rk.Rotation.random(50, rng=0)
+        R @ R, R.mean()
+        w = np.ones((30000, 3))
+        rk.kinematics.integrate_angular_velocity(R[0], w, 1e-3, frame="body")
+        drain(timeout=250)
+        assert averaging._gram_ready()
+        print(sorted(names))
+        """
+    )
+    assert out == "['rigidkit-numba']"
+
+
+def test_compile_host_loop_with_its_declared_signatures():
+    """A host loop built on the background thread, for each declared dtype, with
+    scalar results and arrays of another dtype; a call outside the signatures is
+    refused, not compiled on the caller's thread."""
+    from rigidkit._engine import compile_host_loop, in_background
+
+    if not numba_backend.available():
+        pytest.skip("needs numba")
+
+    def build():
+        return compile_host_loop(
+            _host_sum, ("r1", "r1:int64", "w1", "bool"), returns=("float", "int")
+        )
+
+    job = in_background(("test host loop", id(build)), build)
+    loop = job.result(timeout=240)
+    assert job.done.is_set()
+    for dtype in (np.float64, np.float32):
+        x = np.arange(1.0, 6.0, dtype=dtype)
+        idx = np.array([4, 0, 2], dtype=np.int64)
+        out = np.zeros(3, dtype)
+        total, count = loop(x, idx, out, True)
+        np.testing.assert_array_equal(out, -x[idx])  # exact: a negation
+        assert (total, count) == (float(x[4] + x[0] + x[2]), 3)
+    with pytest.raises(TypeError):
+        loop(np.arange(3.0), np.arange(3.0), np.zeros(3), True)  # float indices
+
+
+def _host_sum(x, idx, out, negate):  # pragma: no cover - compiled by the engine
+    total = 0.0
+    for k in range(idx.shape[0]):
+        v = x[idx[k]]
+        total += v
+        out[k] = -v if negate else v
+    return total, idx.shape[0]
+
+
+def test_owned_function_keeps_the_general_signature_and_refuses_clashes():
+    import inspect
+
+    import rigidkit as rk
+    from rigidkit._engine import owned_function
+    from rigidkit.kernels import geodesic
+
+    def general(a, b, t, *, decoupled=False):
+        """The general case."""
+        return "general"
+
+    fast = owned_function(
+        geodesic.quat_slerp,
+        general,
+        rk.Rotation,
+        ("a", "b"),
+        arrays=("t",),
+        off=("decoupled",),
+        slots=("_data", "_quat"),
+    )
+    assert inspect.signature(fast) == inspect.signature(general)
+    assert fast.__wrapped__ is general and fast.__doc__ == general.__doc__
+    R = rk.Rotation.identity()
+    assert fast(R, R, 0.5, decoupled=True) == "general"  # off its fast path
+    assert fast(R.as_quat(), R, 0.5) == "general"
+
+    def clash(a, b, dt):
+        return None
+
+    with pytest.raises(ValueError, match="reserved"):
+        owned_function(geodesic.quat_slerp, clash, rk.Rotation, ("a", "b"), arrays=("dt",))
+
+
+@pytest.mark.parametrize("library", ["torch", "jax"])
+def test_setup_of_a_library_imported_after_rigidkit(library):
+    """No import hook: jax or torch imported after rigidkit is set up when rigidkit
+    first meets its arrays, even inside ``torch.compile(fullgraph=True)`` (the
+    adapter and bindings are made by an import, which TorchDynamo executes) and
+    inside ``jax.jit`` (an object returned is a pytree by then)."""
+    pytest.importorskip(library)
+    torch_code = """
+        import sys
+        import numpy as np
+        import rigidkit as rk
+        import torch
+        from scipy.spatial.transform import Rotation as SR
+        assert "rigidkit._engine.torch_setup" not in sys.modules  # nothing ran yet
+        q = np.random.default_rng(0).standard_normal((5, 4))
+        def twice(q):
+            R = rk.Rotation.from_quat(q)
+            return R.compose(R).as_matrix()
+        f = torch.compile(twice, fullgraph=True, backend="aot_eager")
+        got = f(torch.as_tensor(q)).numpy()
+        s = SR.from_quat(q, scalar_first=True)
+        assert np.allclose(got, (s * s).as_matrix(), atol=1e-14)
+        R = rk.Rotation.from_quat(torch.as_tensor(q))
+        M = torch.func.vmap(lambda R: R.inv().as_matrix())(R)  # a torch pytree node
+        assert np.allclose(M.numpy(), s.inv().as_matrix(), atol=1e-14)
+        print("ok")
+    """
+    jax_code = """
+        import numpy as np
+        import rigidkit as rk
+        import jax, jax.numpy as jnp
+        from scipy.spatial.transform import Rotation as SR
+        jax.config.update("jax_enable_x64", True)
+        q = np.random.default_rng(0).standard_normal((5, 4))
+        R = jax.jit(lambda q: rk.Rotation.from_quat(q))(jnp.asarray(q))
+        assert type(R) is rk.Rotation
+        M = jax.vmap(lambda R: R.as_matrix())(R)
+        s = SR.from_quat(q, scalar_first=True)
+        assert np.allclose(np.asarray(M), s.as_matrix(), atol=1e-14)
+        print("ok")
+    """
+    assert _fresh(torch_code if library == "torch" else jax_code) == "ok"
+
+
+def test_setup_of_libraries_imported_before_rigidkit():
+    """jax and torch imported first: a NumPy-made object is a pytree of both at once."""
+    pytest.importorskip("torch")
+    pytest.importorskip("jax")
+    out = _fresh(
+        """
+        import sys
+        import jax, torch
+        import rigidkit as rk
+        R = rk.Rotation.random(3, rng=0)
+        assert [x.shape for x in jax.tree_util.tree_leaves(R)] == [(3, 4)]
+        assert [x.shape for x in torch.utils._pytree.tree_leaves(R)] == [(3, 4)]
+        print("ok")
+        """
+    )
+    assert out == "ok"

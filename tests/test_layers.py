@@ -176,3 +176,63 @@ def test_no_layer_imports_one_above_it(layer, forbidden):
         if _layer(target) in forbidden
     }
     assert bad == set()
+
+
+#: What only the engine may do: run code it wrote (the builtins ``exec``, ``eval``,
+#: ``compile``), compile with numba, start threads. The layers above declare what
+#: they need against the engine's public surface (``rigidkit._engine.__init__``).
+ENGINE_ONLY_CALLS = {"exec", "eval", "compile"}
+ENGINE_ONLY_MODULES = {"numba", "threading", "_thread", "concurrent"}
+
+
+def engine_only_uses(source: str) -> set[str]:
+    """The engine-only calls and imports in ``source`` (anywhere, at any depth)."""
+    found = set()
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Call):
+            f = node.func
+            name = f.id if isinstance(f, ast.Name) else getattr(f, "attr", None)
+            if name in ENGINE_ONLY_CALLS and not (
+                isinstance(f, ast.Attribute) and name == "compile"  # re.compile
+            ):
+                found.add(f"{name}()")
+            if isinstance(f, ast.Attribute) and isinstance(f.value, ast.Name):
+                if (f.value.id, f.attr) in {("builtins", "exec"), ("builtins", "compile")}:
+                    found.add(f"builtins.{f.attr}()")
+        elif isinstance(node, ast.Import):
+            found |= {
+                f"import {a.name}"
+                for a in node.names
+                if a.name.split(".")[0] in ENGINE_ONLY_MODULES
+            }
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            if node.module.split(".")[0] in ENGINE_ONLY_MODULES:
+                found.add(f"from {node.module}")
+    return found
+
+
+def test_the_engine_only_check_sees_what_it_looks_for():
+    src = (
+        "import re\nimport numba.core\nfrom concurrent.futures import Future\n"
+        "def f():\n    import threading\n    exec(compile('1', 'x', 'eval'))\n"
+        "    re.compile('a')\n    return eval('1')\n"
+    )
+    assert engine_only_uses(src) == {
+        "import numba.core",
+        "from concurrent.futures",
+        "import threading",
+        "exec()",
+        "compile()",
+        "eval()",
+    }
+
+
+@pytest.mark.parametrize("layer", ["functional", "objects", "applications"])
+def test_only_the_engine_generates_compiles_or_starts_threads(layer):
+    bad = {
+        (name, use)
+        for name, path in MODULES.items()
+        if _layer(name) == layer
+        for use in engine_only_uses(path.read_text(encoding="utf-8"))
+    }
+    assert bad == set()

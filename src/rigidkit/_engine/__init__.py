@@ -54,3 +54,12 @@ __all__ = [
     "run_split",
     "waiting_for_loops",
 ]
+
+# jax or torch imported before rigidkit: set them up now (see post_import).
+import sys as _sys  # noqa: E402
+
+from . import post_import as _post_import  # noqa: E402
+
+if "torch" in _sys.modules:
+    from . import torch_setup as _torch_setup  # noqa: F401
+_post_import.settle()

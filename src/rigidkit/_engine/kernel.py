@@ -42,7 +42,6 @@ import numpy as np
 from . import dask_backend, numba_backend
 from .binding import Helper, _Rebindable, _refuse_redefinition, helper
 from .namespace import (
-    _torch_namespace,
     device_of,
     float_dtype_of,
     is_half,
@@ -102,22 +101,8 @@ class Kernel(_Rebindable):
         self._threaded: dict = {}
         self._nsingle: dict = {}  # one-element calls counted per loop key
         _TORCH_KERNELS.add(self)
-        if _TORCH_BOUND:
-            self._bind_torch()
-
-    def _bind_torch(self):
-        """Bind this kernel to torch now (float32 and float64), not at first use.
-
-        ``torch.compile`` cannot trace the making of a function (the rebinding), and
-        a kernel's first torch call may come inside a compiled function. Scalars
-        are lifted to CPU tensors (``device=None``), which torch combines with
-        tensors of any device, so one binding per dtype serves every device.
-        """
-        xp = _torch_namespace()
-        for dtype in (xp.float32, xp.float64):
-            key = ("torch", str(dtype), "None")
-            if key not in self._xp_cache:
-                self._xp_cache[key] = self.bound(xp_bindings(xp, dtype, None))
+        if TORCH_BIND is not None:  # torch is set up: bound now (see torch_setup)
+            TORCH_BIND(self)
 
     # -- scalar bindings -------------------------------------------------
     @property
@@ -437,7 +422,7 @@ class Kernel(_Rebindable):
             comps += [flat[..., c] for c in range(math.prod(trail))]
         name = getattr(xp, "__name__", id(xp))
         if name == "torch":
-            device = None  # see _bind_torch
+            device = None  # see torch_setup.bind
         key = (name, str(dtype), str(device))
         fn = self._xp_cache.get(key)
         if fn is None:
@@ -462,16 +447,19 @@ class Kernel(_Rebindable):
 _INTS = (int, np.integer)
 _PLAIN = (list, tuple, int, float, type(None))
 
-#: Every kernel, for binding to torch once torch is imported (see Kernel._bind_torch).
+#: Every kernel, bound to torch when torch is set up (:func:`.torch_setup.bind`,
+#: then ``TORCH_BIND``, which binds the kernels made later at their creation).
 _TORCH_KERNELS: weakref.WeakSet = weakref.WeakSet()
-_TORCH_BOUND = False
+TORCH_BIND = None
 
 
 def _bind_all_torch():
-    global _TORCH_BOUND
-    _TORCH_BOUND = True
+    global TORCH_BIND
+    from .torch_setup import bind
+
+    TORCH_BIND = bind
     for k in list(_TORCH_KERNELS):
-        k._bind_torch()
+        bind(k)
 
 
 when_imported("torch", _bind_all_torch)

@@ -9,87 +9,32 @@ input already is one of their arrays.
 
 from __future__ import annotations
 
-import types
-
 import numpy as np
 
-from .post_import import when_imported
+from . import post_import
 
 _TORCH_NS = None
 
 
 def _torch_namespace():
-    global _TORCH_NS
+    """The torch adapter (made by :mod:`.torch_setup` at its first import)."""
     if _TORCH_NS is None:
-        import torch
+        # An import statement, which TorchDynamo executes for real: the first
+        # tensor may come inside torch.compile (see torch_setup).
+        from .torch_setup import NAMESPACE
 
-        def asarray(x, dtype=None, device=None, copy=None):
-            if isinstance(x, torch.Tensor):
-                out = x
-                if dtype is not None and out.dtype != dtype:
-                    out = out.to(dtype)
-                if device is not None and out.device != torch.device(device):
-                    out = out.to(device)
-                return out.clone() if copy else out
-            return torch.as_tensor(x, dtype=dtype, device=device)
-
-        ns = types.SimpleNamespace(
-            __name__="torch",
-            float32=torch.float32,
-            float64=torch.float64,
-            bool=torch.bool,
-            sqrt=torch.sqrt,
-            sin=torch.sin,
-            cos=torch.cos,
-            tan=torch.tan,
-            asin=torch.asin,
-            acos=torch.acos,
-            atan=torch.atan,
-            atan2=torch.atan2,
-            exp=torch.exp,
-            log=torch.log,
-            abs=torch.abs,
-            where=torch.where,
-            maximum=torch.maximum,
-            minimum=torch.minimum,
-            copysign=torch.copysign,
-            isfinite=torch.isfinite,
-            asarray=asarray,
-            stack=lambda arrays, axis=0: torch.stack(tuple(arrays), dim=axis),
-            concat=lambda arrays, axis=0: torch.cat(tuple(arrays), dim=axis),
-            broadcast_to=lambda x, shape: torch.broadcast_to(x, tuple(shape)),
-            reshape=lambda x, shape: torch.reshape(x, tuple(shape)),
-            zeros=lambda shape, dtype=None, device=None: torch.zeros(
-                tuple(shape), dtype=dtype, device=device
-            ),
-            all=lambda x, axis=None: (
-                torch.all(x) if axis is None else torch.all(x, dim=axis)
-            ),
-            any=lambda x, axis=None: (
-                torch.any(x) if axis is None else torch.any(x, dim=axis)
-            ),
-            sum=lambda x, axis=None: (
-                torch.sum(x) if axis is None else torch.sum(x, dim=axis)
-            ),
-            isdtype=lambda dtype, kind: (
-                dtype.is_floating_point if kind == "real floating" else False
-            ),
-            nonzero=torch.nonzero,
-            ones_like=torch.ones_like,
-            zeros_like=torch.zeros_like,
-            linalg=torch.linalg,
-            max=lambda x, axis=None: (
-                torch.amax(x) if axis is None else torch.amax(x, dim=axis)
-            ),
-            matmul=torch.matmul,
-        )
-        _TORCH_NS = ns
+        return NAMESPACE
     return _TORCH_NS
 
 
-# Built when torch is imported, not at first use: ``torch.compile`` cannot trace the
-# construction of the namespace, and a first use may be inside a compiled function.
-when_imported("torch", _torch_namespace)
+def _set_torch_namespace():
+    global _TORCH_NS
+    from .torch_setup import NAMESPACE
+
+    _TORCH_NS = NAMESPACE
+
+
+post_import.when_imported("torch", _set_torch_namespace)
 
 
 def is_torch(x) -> bool:
@@ -106,6 +51,8 @@ def namespace_of(*arrays):
             ns = _torch_namespace()
         elif hasattr(a, "__array_namespace__"):
             ns = a.__array_namespace__()
+            if post_import.PENDING:  # jax's setup, say, once jax's arrays come
+                post_import.settle()
         else:
             continue
         if found is None:

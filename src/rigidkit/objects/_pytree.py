@@ -2,10 +2,10 @@
 
 Each class holds one array (:class:`~rigidkit.objects._batch.BatchedArray`), its
 only leaf: ``jax.jit``, ``jax.vmap``, ``jax.grad`` and ``torch.func`` then take and
-return ``Rotation``, ``Transform``, ... as they do arrays. Registration happens when
-jax (resp. torch) is imported, or at class creation if it already is
-(:func:`rigidkit._engine.post_import.when_imported`): ``import rigidkit`` imports
-neither.
+return ``Rotation``, ``Transform``, ... as they do arrays. Registration happens at
+class creation if jax (resp. torch) is already imported, else when rigidkit first
+meets one of its arrays (:func:`rigidkit._engine.post_import.when_imported`):
+``import rigidkit`` imports neither.
 
 >>> import rigidkit as rk
 >>> from rigidkit.objects import _pytree
