@@ -17,7 +17,11 @@ simulation                ``imu_from_trajectory``, ``simulate_imu``
 ========================  ===========================================================
 """
 
+from .preintegration import *  # noqa: F403
+from .preintegration import __all__ as _preintegration_names
 from .strapdown import *  # noqa: F403
 from .strapdown import __all__ as _strapdown_names
+from .windows import *  # noqa: F403
+from .windows import __all__ as _windows_names
 
-__all__ = [*_strapdown_names]
+__all__ = [*_strapdown_names, *_preintegration_names, *_windows_names]
