@@ -13,15 +13,18 @@ strapdown integration     ``integrate`` (``"exact"``, ``"midpoint"``, ``"rk4"``)
 preintegration            ``preintegrate``, ``Preintegrated`` (``predict``,
                           ``corrected``, ``residual``), ``ImuNoise``, ``split_windows``,
                           GTSAM's layout: ``to_gtsam``, ``from_gtsam``
-simulation                ``imu_from_trajectory``, ``simulate_imu``
+simulation                ``imu_from_trajectory``, ``simulate_imu`` (``ImuLog``),
+                          ``states_from_trajectory``
 ========================  ===========================================================
 """
 
 from .preintegration import *  # noqa: F403
 from .preintegration import __all__ as _preintegration_names
+from .simulation import *  # noqa: F403
+from .simulation import __all__ as _simulation_names
 from .strapdown import *  # noqa: F403
 from .strapdown import __all__ as _strapdown_names
 from .windows import *  # noqa: F403
 from .windows import __all__ as _windows_names
 
-__all__ = [*_strapdown_names, *_preintegration_names, *_windows_names]
+__all__ = [*_strapdown_names, *_preintegration_names, *_windows_names, *_simulation_names]
