@@ -41,6 +41,15 @@ def nearest_pairs(ref_stamps, est_stamps, max_diff):
     return (i_short, i_long) if short_is_ref else (i_long, i_short)
 
 
+def _take(traj, idx):
+    """The poses at the non-decreasing indices ``idx``; a view where they are a
+    run of consecutive indices (a million poses are 56 MB to copy)."""
+    a, b = int(idx[0]), int(idx[-1]) + 1
+    if b - a == len(idx) and (len(idx) < 2 or bool((np.diff(idx) == 1).all())):
+        idx = slice(a, b)
+    return Trajectory._trusted(traj.stamps[idx], traj.poses[..., idx])
+
+
 def _range(t) -> str:
     return f"[{float(t[0])!r}, {float(t[-1])!r}]" if len(t) else "[] (no poses)"
 
@@ -99,10 +108,7 @@ def associate(ref, est, max_diff=0.01, offset=0.0, method="nearest", max_gap=Non
     if method == "nearest":
         i_ref, i_est = nearest_pairs(t_ref, t_est, float(max_diff))
         if len(i_ref):
-            return (
-                Trajectory._trusted(t_ref[i_ref], ref.poses[..., i_ref]),
-                Trajectory._trusted(est.stamps[i_est], est.poses[..., i_est]),
-            )
+            return _take(ref, i_ref), _take(est, i_est)
     elif method == "interpolate":
         keep = (t_est >= t_ref[0]) & (t_est <= t_ref[-1]) if len(t_ref) else t_est < 0
         if max_gap is not None and len(t_ref) > 1:
