@@ -346,12 +346,17 @@ def _preintegrate(w, f, h, bg, ba, noise, method, xp):
     J = -xp.sum(M, axis=-3)
     cov = None
     if noise is not None:
+        # sum_k M_k Q_k M_k^T as one product A A^T, A = [M_k sqrt(Q_k)] (9 x 6N): one
+        # BLAS call per window instead of N small products.
         hh = h if len(h.shape) else h + 0.0 * wc[..., 0]
         safe = xp.where(hh > 0, hh, 1.0)
-        qg = xp.where(hh > 0, noise.gyro_noise_density**2 / safe, 0.0)[..., None, None]
-        qa = xp.where(hh > 0, noise.accel_noise_density**2 / safe, 0.0)[..., None, None]
-        Mg, Ma = M[..., :3], M[..., 3:]
-        cov = xp.sum(qg * xp.matmul(Mg, _swap(Mg)) + qa * xp.matmul(Ma, _swap(Ma)), axis=-3)
+        root = xp.where(hh > 0, 1.0 / xp.sqrt(safe), 0.0)[..., None, None]
+        sigma = _cast([noise.gyro_noise_density] * 3 + [noise.accel_noise_density] * 3, M)
+        A = M * (root * sigma)  # (..., N, 9, 6), columns scaled by sigma / sqrt(h)
+        nd = len(A.shape)
+        A = xp.permute_dims(A, tuple(range(nd - 3)) + (nd - 2, nd - 3, nd - 1))
+        A = xp.reshape(A, tuple(A.shape[:-2]) + (A.shape[-2] * 6,))
+        cov = xp.matmul(A, _swap(A))
     batch = tuple(J.shape[:-2])
     bg = xp.broadcast_to(bg, batch + (3,))
     ba = xp.broadcast_to(ba, batch + (3,))
