@@ -91,6 +91,7 @@ def make_fast(kernel):
         "PMIN": numba_backend.PARALLEL_MIN,
         "py": kernel.python,
         "INTS": _INTS,
+        "single_out": single_out,
     }
     n = len(kernel.inputs)
     for j in [None, *range(n)]:
@@ -102,6 +103,28 @@ def make_fast(kernel):
     src = fast_source(kernel)
     exec(compile(src, f"<rigidkit fast {kernel.name}>", "exec"), env)
     return env["fast"]
+
+
+def single_out(kernel, res, out, dt):
+    """Write one element's results ``res`` (a tuple of floats) into ``out=``
+    (the fast entry's one-element call with ``out=``)."""
+    outs = [out] if len(kernel.outputs) == 1 else list(out)
+    k = 0
+    for o, s in zip(outs, kernel.outputs):
+        if type(o) is not np.ndarray or o.shape != s:
+            raise ValueError(
+                f"{kernel.name}: out= needs a NumPy array of shape {s}, got "
+                f"{getattr(o, 'shape', type(o).__name__)}"
+            )
+        m = math.prod(s)
+        if not s:
+            o[()] = res[k]
+        elif len(s) == 1:
+            o[:] = res[k : k + m]
+        else:  # .flat: a strided buffer's reshape(-1) would be a copy
+            o.flat = res[k : k + m]
+        k += m
+    return kernel._finish(outs)
 
 
 def _loop_key(params) -> str:
@@ -227,7 +250,7 @@ def fast_source(kernel) -> str:
     L.append(f"                r = py({', '.join(call)})")
     L.append("                if out is None:")
     L += ["                    " + line for line in _pack_single(outs)]
-    L.append("                return self._single_out(r, out, dt)")
+    L.append("                return single_out(self, r, out, dt)")
     # -- one batch axis: index tests on the shapes (a slice costs ~60 ns each) -------
     patterns = [(None, tuple(False for _ in ins))]
     if len(ins) > 1:

@@ -198,26 +198,6 @@ class Kernel(_Rebindable):
         dtype = float_dtype_of(np, *[np.empty(0, dtype=a.dtype) for a in arrays])
         return dask_backend.call(self, params, arrays, dtype)
 
-    def _single_out(self, res, out, dt):
-        """Write one element's results ``res`` (a tuple of floats) into ``out=``."""
-        outs = [out] if len(self.outputs) == 1 else list(out)
-        k = 0
-        for o, s in zip(outs, self.outputs):
-            if type(o) is not np.ndarray or o.shape != s:
-                raise ValueError(
-                    f"{self.name}: out= needs a NumPy array of shape {s}, got "
-                    f"{getattr(o, 'shape', type(o).__name__)}"
-                )
-            m = math.prod(s)
-            if not s:
-                o[()] = res[k]
-            elif len(s) == 1:
-                o[:] = res[k : k + m]
-            else:  # .flat: a strided buffer's reshape(-1) would be a copy
-                o.flat = res[k : k + m]
-            k += m
-        return self._finish(outs)
-
     def _loop_ready(self, bcast, dtype, ints, loop, nogil=False):
         """Called by the background loader when a compiled loop can be used.
 

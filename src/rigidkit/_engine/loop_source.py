@@ -93,7 +93,7 @@ def _loop_source(kernel, bcast=()) -> str:
             call += [f"b{k}_{c}" for c in range(w)]
             continue
         # Its length too: a generated function may pass a caller's array whose
-        # length it has not tested (dispatch.owned_source's user arrays).
+        # length it has not tested (owned.owned_source's user arrays).
         strided += [f"A{k}.shape[0] != n", *_stride_tests(f"A{k}", shape)]
         if w <= FLAT_MAX:
             pre.append(f"    a{k} = A{k}.reshape(A{k}.size)")
