@@ -165,6 +165,7 @@ def test_low_layers_import_only_below_them(layer, allowed):
         ("functional", {"objects", "applications"}),
         ("objects", {"applications"}),
         ("_validate", {"kernels", "functional", "objects", "applications"}),
+        ("_tolerances", {"kernels", "_engine", "functional", "objects", "applications"}),
     ],
 )
 def test_no_layer_imports_one_above_it(layer, forbidden):
