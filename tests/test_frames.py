@@ -162,6 +162,28 @@ def test_interpolation_is_rk_slerp(decoupled):
         np.testing.assert_allclose(one, want[k], atol=1e-14)
 
 
+@pytest.mark.parametrize("interpolation", ["decoupled", "screw"])
+def test_times_in_order_match_times_in_any_order(robot, interpolation):
+    """Times in increasing order (more of them than samples) find their segments
+    from the stamps' side; in any other order by a search per time: the same
+    segments, so the same poses, and both those of scipy's composition. The times
+    include both ends of the common range, stamps of each edge and repeats."""
+    g, data = robot
+    rng = np.random.default_rng(11)
+    (s1, _), (s2, _) = data["map", "odom"], data["odom", "base"]
+    lo, hi = max(s1[0], s2[0]), min(s1[-1], s2[-1])
+    stamps = [s[(s >= lo) & (s <= hi)] for s in (s1, s2)]
+    times = np.sort(np.concatenate([rng.uniform(lo, hi, 300), *stamps, [lo, hi, hi]]))
+    times = np.concatenate([times[:50], times[49:]])  # a repeated time
+    assert len(times) > 40 and np.all(np.diff(times) >= 0)
+    rule = decoupled_reference if interpolation == "decoupled" else screw_reference
+    got = g.get("tag", "camera", at=times, interpolation=interpolation)
+    np.testing.assert_allclose(got.as_matrix(), explicit(data, times, rule), atol=1e-10)
+    perm = rng.permutation(len(times))
+    shuffled = g.get("tag", "camera", at=times[perm], interpolation=interpolation)
+    np.testing.assert_array_equal(shuffled.as_matrix(), got[perm].as_matrix())
+
+
 def test_exact_at_samples_and_latest_common_time(robot):
     g, data = robot
     s, pq = data["map", "odom"]

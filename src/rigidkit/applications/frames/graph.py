@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..._engine import Lock
@@ -270,17 +272,21 @@ class FrameGraph:
     def _planned(self, target, source):
         """The two chains of :meth:`_resolve` with each run of static edges composed
         once (cached with the path until the tree or a static pose changes), and a
-        snapshot of each dynamic edge: ``(items_s, items_t)``, each item a static
-        ``Transform`` or a dynamic edge's :class:`Snapshot`, from the top down."""
+        snapshot of each dynamic edge: ``(items_s, items_t, moving)``, each item a
+        static ``Transform`` or a dynamic edge's :class:`Snapshot`, from the top
+        down; ``moving``: whether any edge is dynamic."""
         key = (target, source, "plan")
         with self._lock:
             plan = self._paths.get(key)
             if plan is None:
                 up_s, up_t = self._resolve(target, source)
-                plan = self._paths[key] = (fold_static(up_s), fold_static(up_t))
+                items_s, items_t = fold_static(up_s), fold_static(up_t)
+                moving = any(type(x) is not Transform for x in items_s + items_t)
+                plan = self._paths[key] = (items_s, items_t, moving)
             return (
                 [x if type(x) is Transform else x.snapshot() for x in plan[0]],
                 [x if type(x) is Transform else x.snapshot() for x in plan[1]],
+                plan[2],
             )
 
     # -- lookups -------------------------------------------------------------------
@@ -386,8 +392,11 @@ class FrameGraph:
             up_s, up_t = self._snap(str(target), str(source))
             q, shape = query_times(at, up_s + up_t)
             return path_covariance(up_s, up_t, q, shape, interpolation, extrapolate)
-        up_s, up_t = self._planned(str(target), str(source))
-        q, shape = query_times(at, [x for x in up_s + up_t if type(x) is not Transform])
+        up_s, up_t, moving = self._planned(str(target), str(source))
+        if type(at) is float and moving and math.isfinite(at):
+            q, shape = at, ()  # one time, the most frequent call: query_times's result
+        else:
+            q, shape = query_times(at, [x for x in up_s + up_t if type(x) is not Transform])
         T = compose_path(up_s, up_t, q, interpolation, extrapolate)
         return shaped(T, shape)
 
