@@ -1,6 +1,7 @@
 """``a @ b`` and ``a.inv()`` go straight from the operator to the compiled loop.
 
-The generated methods (``objects.group._owned_method``) skip the kernel's entry
+The methods the engine writes (``_engine.owned_function``, declared by
+``objects.group.owned_method``) skip the kernel's entry
 for two NumPy batches of one kind, shape and dtype; every other case (strided
 storage, N-D batches, mixed dtypes, one element against a batch) must reach the
 general method and agree. Checked against the product and the inverse of the
