@@ -334,3 +334,28 @@ def test_against_gtsam_converging_at_first_order(method):
     np.testing.assert_allclose(
         rk.inertial.to_gtsam(back)[1], ref.preintMeasCov(), atol=1e-15
     )
+
+
+def test_the_rate_of_cos_defect4_against_mpmath():
+    """``(d cos_defect4 / dx) / x``, the one coefficient the exact step's Jacobian adds
+    (:func:`rigidkit.kernels.kinematics.inertial_jacobians.cos_defect4_rate`): within a
+    few ulp of mpmath's derivative of ``(cos x - 1 + x^2/2) / x^4`` at 50 digits, from
+    1e-8 to 6 (its series-free form has no threshold to straddle)."""
+    mp = pytest.importorskip("mpmath")
+    from rigidkit.kernels.kinematics.inertial_jacobians import cos_defect4_rate
+
+    mp.mp.dps = 50
+    x = np.concatenate([np.geomspace(1e-8, 1e-1, 30), np.linspace(0.1, 6.0, 60)])
+    got = np.array([cos_defect4_rate(float(v)) for v in x])  # the scalar binding
+
+    def c2(t):
+        return (mp.cos(t) - 1 + t**2 / 2) / t**4
+
+    def ref(v):
+        t = mp.mpf(v)
+        if t < mp.mpf("1e-3"):  # the series: -1/360 + t^2/10080 - t^4/604800
+            return float(-mp.mpf(1) / 360 + t**2 / 10080 - t**4 / 604800)
+        return float(mp.diff(c2, t) / t)
+
+    want = np.array([ref(v) for v in x])
+    np.testing.assert_allclose(got, want, rtol=8 * np.finfo(float).eps, atol=0)

@@ -205,3 +205,31 @@ def test_jax_jit_matches_numpy(jax, jnp, rng):
     got = np.asarray(f(jnp.asarray(X0._data), jnp.asarray(gyro), jnp.asarray(accel)))
     want = rk.inertial.integrate(X0, gyro, accel, 0.01, gravity=G).as_matrix()
     np.testing.assert_allclose(got, want, rtol=0, atol=1e-12)
+
+
+@pytest.mark.exhaustive  # ~40 s of XLA compiles on a small CI machine
+def test_jax_vmap_and_grad(jax, jnp, rng):
+    """``jax.vmap`` over logs equals the batched NumPy call; ``jax.grad`` of the final
+    position in the specific forces is the closed form of the torch test."""
+    gyro = rng.standard_normal((4, 16, 3))
+    accel = rng.standard_normal((4, 16, 3))
+    X0 = rk.ExtendedPose.random((), rng)
+    x0 = jnp.asarray(X0._data)
+
+    def final(w, a):
+        X = rk.inertial.integrate(
+            rk.ExtendedPose._wrap(x0), w, a, 0.01, gravity=G, method="exact"
+        )
+        return X._data[-1]
+
+    got = np.asarray(jax.vmap(final)(jnp.asarray(gyro), jnp.asarray(accel)))
+    want = rk.inertial.integrate(X0, gyro, accel, 0.01, gravity=G, method="exact")._data[
+        :, -1
+    ]
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-12)
+    zero = jnp.zeros((16, 3))
+    g = jax.grad(lambda a: final(zero, a)[7])(jnp.asarray(accel[0]))
+    R0 = X0.rotation.as_matrix()
+    h, tk = 0.01, 0.01 * np.arange(16)
+    weights = h * (16 * h - tk) - h * h / 2  # d p_N / d f_k = R0 (that weight)
+    np.testing.assert_allclose(np.asarray(g), np.outer(weights, R0[0]), rtol=0, atol=1e-13)
