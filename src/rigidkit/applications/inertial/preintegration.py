@@ -406,6 +406,17 @@ def to_gtsam(pim):
     ``theta`` (``Exp(theta + d) = Exp(theta) Exp(J_r(theta) d)``), ours is the right
     perturbation ``phi = J_r(theta) d``, so its covariance is ``J_r^-1 S J_r^-T``.
     NumPy arrays, shapes (..., 9) and (..., 9, 9) (None without a covariance).
+
+    >>> import numpy as np
+    >>> import rigidkit as rk
+    >>> w, f = np.tile([0.0, 0.0, 1.0], (10, 1)), np.tile([1.0, 0.0, 9.81], (10, 1))
+    >>> pim = rk.inertial.preintegrate(w, f, 0.01, noise=rk.inertial.ImuNoise(1e-3, 1e-2))
+    >>> zeta, cov = rk.inertial.to_gtsam(pim)
+    >>> np.round(zeta[:3], 12) + 0.0                   # theta: 0.1 rad about z
+    array([0. , 0. , 0.1])
+    >>> same_p = np.allclose(cov[3:6, 3:6], pim.covariance[6:, 6:])  # p: rows 7-9 here
+    >>> bool(np.allclose(zeta[6:], pim.delta_v)), bool(same_p)
+    (True, True)
     """
     theta = np.asarray(pim.delta_R.as_rotvec())
     zeta = np.concatenate([theta, np.asarray(pim.delta_p), np.asarray(pim.delta_v)], -1)
@@ -417,7 +428,13 @@ def to_gtsam(pim):
 
 def from_gtsam(zeta, covariance=None):
     """``(delta_R, delta_v, delta_p, covariance)`` in our layout from GTSAM's
-    ``preintegrated()`` and ``preintMeasCov()`` (see :func:`to_gtsam`)."""
+    ``preintegrated()`` and ``preintMeasCov()`` (see :func:`to_gtsam`).
+
+    >>> import numpy as np
+    >>> R, dv, dp, _ = from_gtsam([0.0, 0.0, 0.1, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0])
+    >>> np.round(R.as_rotvec(), 12) + 0.0, dv, dp
+    (array([0. , 0. , 0.1]), array([4., 5., 6.]), array([1., 2., 3.]))
+    """
     zeta = np.asarray(zeta, dtype=np.float64)
     R = Rotation.from_rotvec(zeta[..., :3])
     cov = None

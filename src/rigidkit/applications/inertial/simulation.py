@@ -107,7 +107,16 @@ def imu_from_trajectory(trajectory, times, *, gravity=GRAVITY, earth_rate=None):
 
 def states_from_trajectory(trajectory, times):
     """The navigation states ``(R, v, p)`` along ``trajectory`` at ``times``
-    (``v = R v_b``, in the navigation frame ``"world"``), an ExtendedPose (...)."""
+    (``v = R v_b``, in the navigation frame ``"world"``), an ExtendedPose (...).
+
+    >>> import numpy as np
+    >>> import rigidkit as rk
+    >>> ctrl = rk.Transform.exp(np.outer(np.arange(6.0), [1.0, 0, 0, 0, 0, 0.0]))
+    >>> X = rk.inertial.states_from_trajectory(rk.BSplineSE3(ctrl), [0.0, 2.0])
+    >>> np.round(X.velocity, 12) + 0.0, np.round(X.position[:, 0], 12) + 0.0
+    (array([[1., 0., 0.],
+           [1., 0., 0.]]), array([1., 3.]))
+    """
     T = trajectory(times)
     V = np.asarray(trajectory(times, 1, frame="body"))
     R = T.rotation
