@@ -185,3 +185,26 @@ def test_plot_functions_draw_on_new_or_given_axes():
     assert len(ax.collections) == 1
     with pytest.raises(ValueError, match="plane"):
         rk.trajectory.plot(traj, plane="xyz")
+
+
+def test_torch_poses_give_the_numpy_numbers():
+    torch = pytest.importorskip("torch")
+    a = rk.Transform.random(12, rng=5)
+    b = rk.Transform.random(12, rng=6)
+    t = np.arange(12.0)
+    ref, est = rk.Trajectory(t, a), rk.Trajectory(t, b)
+    ref_t = rk.Trajectory(t, rk.Transform.from_pq(torch.tensor(a.as_pq())))
+    est_t = rk.Trajectory(t, rk.Transform.from_pq(torch.tensor(b.as_pq())))
+    assert isinstance(ref_t.positions, torch.Tensor)
+    assert ref_t.path_length == pytest.approx(ref.path_length, rel=1e-14)
+    for relation in ("translation", "full", "rotation_angle"):
+        np.testing.assert_allclose(
+            rk.trajectory.rpe(ref_t, est_t, relation=relation).errors,
+            rk.trajectory.rpe(ref, est, relation=relation).errors,
+            rtol=1e-12,
+        )
+        np.testing.assert_allclose(
+            rk.trajectory.ape(ref_t, est_t, relation=relation).errors,
+            rk.trajectory.ape(ref, est, relation=relation).errors,
+            rtol=1e-12,
+        )

@@ -137,6 +137,7 @@ def _distance(a, b):
     strided views into the poses, on which NumPy's loops over an axis of 3 cost
     ~10x more than three 1-D passes."""
     # In place after the first two: a million poses make 8 MB per temporary.
+    a, b = np.asarray(a), np.asarray(b)  # the metrics are computed in NumPy
     out = a[..., 0] - b[..., 0]
     out *= out
     d = a[..., 1] - b[..., 1]
