@@ -195,8 +195,11 @@ def group_rows(rk, repeat):
         "ExtendedPose log": lambda: X.log(),
         "Transform log": lambda: T.log(),
     }
-    for f in fns.values():
+    from rigidkit._engine import numba_backend
+
+    for f in fns.values():  # the first batch over PARALLEL_MIN asks for the threaded loop
         f()
+    numba_backend.drain(timeout=600)
     med = C.interleaved_medians(fns, repeat=repeat, min_sample=0.2)
     rows = []
     for op in ("compose", "exp", "log"):
