@@ -184,6 +184,38 @@ def test_times_in_order_match_times_in_any_order(robot, interpolation):
     np.testing.assert_array_equal(shuffled.as_matrix(), got[perm].as_matrix())
 
 
+@pytest.mark.parametrize("interpolation", ["decoupled", "screw"])
+def test_many_times_in_blocks(robot, monkeypatch, interpolation):
+    """Many times are computed a block of rows at a time: the rows of one pass (and
+    scipy's), the error of one pass (a time in the past in a later block than one
+    in the future: the past is named, as without blocks), the clamp of one pass."""
+    from rigidkit.applications.frames import lookup
+
+    g, data = robot
+    rng = np.random.default_rng(12)
+    (s1, _), (s2, _) = data["map", "odom"], data["odom", "base"]
+    lo, hi = max(s1[0], s2[0]), min(s1[-1], s2[-1])
+    rule = decoupled_reference if interpolation == "decoupled" else screw_reference
+    times = rng.uniform(lo, hi, 700)
+    for at in (times, np.sort(times)):
+        monkeypatch.setattr(lookup, "BLOCK", 10**9)
+        whole = g.get("tag", "camera", at=at, interpolation=interpolation)
+        monkeypatch.setattr(lookup, "BLOCK", 64)
+        blocks = g.get("tag", "camera", at=at, interpolation=interpolation)
+        np.testing.assert_array_equal(blocks.as_matrix(), whole.as_matrix())
+        np.testing.assert_allclose(blocks.as_matrix(), explicit(data, at, rule), atol=1e-10)
+    bad = times.copy()
+    bad[10], bad[500] = hi + 1.0, lo - 1.0
+    with pytest.raises(rk.ExtrapolationError) as err:
+        g.get("tag", "camera", at=bad, interpolation=interpolation)
+    assert err.value.direction == "past" and err.value.edge == ("map", "odom")
+    clamped = g.get("tag", "camera", at=bad, extrapolate="clamp")
+    monkeypatch.setattr(lookup, "BLOCK", 10**9)
+    np.testing.assert_array_equal(
+        clamped.as_matrix(), g.get("tag", "camera", at=bad, extrapolate="clamp").as_matrix()
+    )
+
+
 def test_exact_at_samples_and_latest_common_time(robot):
     g, data = robot
     s, pq = data["map", "odom"]

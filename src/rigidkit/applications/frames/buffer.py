@@ -188,7 +188,7 @@ class Snapshot:
             direction=direction,
         )
 
-    def locate(self, q):
+    def locate(self, q, many=None):
         """Segment index ``i`` and fraction ``a`` of each time: between ``t[i]`` and
         ``t[i + 1]`` (``q`` already within range; ``i = 0``, ``a = 0`` for one sample).
 
@@ -211,13 +211,13 @@ class Snapshot:
             i = t.searchsorted(q, side="right") - 1
             np.clip(i, 0, n - 2, out=i)
         a = q - np.take(t, i)
-        if 4 * m >= n:  # the batch path (see at): steps taken once per snapshot
+        if 4 * (m if many is None else many) >= n:  # steps once per snapshot (see at)
             a /= np.take(self.increments("steps"), i)
         else:  # few times on a long buffer: O(M)
             a /= np.take(t, i + 1) - np.take(t, i)
         return i, a
 
-    def at(self, q, interpolation, want_cov=False):
+    def at(self, q, interpolation, want_cov=False, *, many=None):
         """``parent_T_child`` at times ``q`` (shape (M,) array, within range).
 
         Returns ``(Transform of shape (M,), cov (M, 6, 6) or None)``. Between two
@@ -225,8 +225,12 @@ class Snapshot:
         linearly and slerps the rotation; ``"screw"`` follows the SE(3) geodesic
         ``T_i exp(a log(T_i^-1 T_{i+1}))`` (Sola et al. 2018, eq. 178). The
         covariance is interpolated linearly, ``(1 - a) C_i + a C_{i+1}``.
+        ``many``: the call's total count of times when ``q`` is one block of it
+        (the way of interpolating is chosen for the call, so a block's rows are
+        those of the call without blocks).
         """
-        i, a = self.locate(q)
+        many = q.shape[0] if many is None else many
+        i, a = self.locate(q, many)
         pq = self.pq
         if pq.shape[0] == 1:
             T = wrap_pq(np.broadcast_to(pq[0], q.shape + (7,)).copy())
@@ -234,7 +238,7 @@ class Snapshot:
             if want_cov and self.cov is not None:
                 cov = np.broadcast_to(self.cov[0], q.shape + (6, 6)).copy()
             return T, cov
-        if 4 * q.shape[0] >= pq.shape[0]:
+        if 4 * many >= pq.shape[0]:
             T = self._from_increments(i, a, interpolation)
         else:
             T = slerp(
