@@ -342,25 +342,42 @@ def _preintegrate(w, f, h, bg, ba, noise, method, xp):
     inc, S = _step_fns(method, wc, fc, h, xp)
     D = running_steps(inc)
     end = D[..., -1:, :]
-    M = _kj.preintegration_sensitivity(D[..., :-1, :], D[..., 1:, :], end, S)
-    J = -xp.sum(M, axis=-3)
+    first, after = D[..., :-1, :], D[..., 1:, :]
     cov = None
-    if noise is not None:
-        # sum_k M_k Q_k M_k^T as one product A A^T, A = [M_k sqrt(Q_k)] (9 x 6N): one
-        # BLAS call per window instead of N small products.
+    if noise is None:
+        M = _kj.preintegration_sensitivity(first, after, end, S)
+    else:
+        # The discrete variances sigma^2 / h of each step (eq. 45); a step of zero
+        # duration (padding) has M = 0 and adds nothing.
         hh = h if len(h.shape) else h + 0.0 * wc[..., 0]
         safe = xp.where(hh > 0, hh, 1.0)
-        root = xp.where(hh > 0, 1.0 / xp.sqrt(safe), 0.0)[..., None, None]
-        sigma = _cast([noise.gyro_noise_density] * 3 + [noise.accel_noise_density] * 3, M)
-        A = M * (root * sigma)  # (..., N, 9, 6), columns scaled by sigma / sqrt(h)
-        nd = len(A.shape)
-        A = xp.permute_dims(A, tuple(range(nd - 3)) + (nd - 2, nd - 3, nd - 1))
-        A = xp.reshape(A, tuple(A.shape[:-2]) + (A.shape[-2] * 6,))
-        cov = xp.matmul(A, _swap(A))
+        inv = xp.where(hh > 0, 1.0 / safe, 0.0)
+        qg = noise.gyro_noise_density**2 * inv
+        qa = noise.accel_noise_density**2 * inv
+        M, C = _kj.preintegration_sensitivity_noise(first, after, end, S, qg, qa)
+        cov = _symmetric(xp.sum(C, axis=-2), xp)  # each step's share, summed
+    J = -xp.sum(M, axis=-3)
     batch = tuple(J.shape[:-2])
     bg = xp.broadcast_to(bg, batch + (3,))
     ba = xp.broadcast_to(ba, batch + (3,))
     return Preintegrated(end[..., 0, :], J, cov, bg, ba)
+
+
+#: Row and column of each of the 45 upper-triangle entries, and the 81 entries of the
+#: full 9x9 matrix as indices into them.
+_UPPER = np.triu_indices(9)
+_FULL = np.zeros((9, 9), dtype=np.int64)
+_FULL[_UPPER] = np.arange(45)
+_FULL.T[_UPPER] = np.arange(45)
+
+
+def _symmetric(upper, xp):
+    """The symmetric (..., 9, 9) matrices of their upper triangles (..., 45)."""
+    idx = _FULL.reshape(-1)
+    if not is_numpy(xp):
+        idx = xp.asarray(idx, device=device_of(upper))
+    full = xp.take(upper, idx, axis=-1)
+    return xp.reshape(full, tuple(upper.shape[:-1]) + (9, 9))
 
 
 def _chunked(w, f, h, bg, ba, noise, method, batch):

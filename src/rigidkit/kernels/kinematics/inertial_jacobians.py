@@ -212,20 +212,110 @@ def imu_step_jacobian_midpoint(ax, ay, az, fx, fy, fz, bx, by, bz, gx, gy, gz, h
 # -- preintegration: how each step's error reaches the window's end ----------------------
 
 
-@kernel(inputs=[(11,), (11,), (11,), (9, 6)], outputs=[(9, 6)])
-def preintegration_sensitivity(
+@helper
+def weighted_gram45(m, qg, qa):
+    """The 45 entries (upper triangle, row by row) of ``M diag(qg I, qa I) M^T`` for a
+    9x6 ``M`` (a 54-tuple): one step's share of the preintegrated covariance."""
+    return (
+        qg * (m[0] * m[0] + m[1] * m[1] + m[2] * m[2])
+        + qa * (m[3] * m[3] + m[4] * m[4] + m[5] * m[5]),
+        qg * (m[0] * m[6] + m[1] * m[7] + m[2] * m[8])
+        + qa * (m[3] * m[9] + m[4] * m[10] + m[5] * m[11]),
+        qg * (m[0] * m[12] + m[1] * m[13] + m[2] * m[14])
+        + qa * (m[3] * m[15] + m[4] * m[16] + m[5] * m[17]),
+        qg * (m[0] * m[18] + m[1] * m[19] + m[2] * m[20])
+        + qa * (m[3] * m[21] + m[4] * m[22] + m[5] * m[23]),
+        qg * (m[0] * m[24] + m[1] * m[25] + m[2] * m[26])
+        + qa * (m[3] * m[27] + m[4] * m[28] + m[5] * m[29]),
+        qg * (m[0] * m[30] + m[1] * m[31] + m[2] * m[32])
+        + qa * (m[3] * m[33] + m[4] * m[34] + m[5] * m[35]),
+        qg * (m[0] * m[36] + m[1] * m[37] + m[2] * m[38])
+        + qa * (m[3] * m[39] + m[4] * m[40] + m[5] * m[41]),
+        qg * (m[0] * m[42] + m[1] * m[43] + m[2] * m[44])
+        + qa * (m[3] * m[45] + m[4] * m[46] + m[5] * m[47]),
+        qg * (m[0] * m[48] + m[1] * m[49] + m[2] * m[50])
+        + qa * (m[3] * m[51] + m[4] * m[52] + m[5] * m[53]),
+        qg * (m[6] * m[6] + m[7] * m[7] + m[8] * m[8])
+        + qa * (m[9] * m[9] + m[10] * m[10] + m[11] * m[11]),
+        qg * (m[6] * m[12] + m[7] * m[13] + m[8] * m[14])
+        + qa * (m[9] * m[15] + m[10] * m[16] + m[11] * m[17]),
+        qg * (m[6] * m[18] + m[7] * m[19] + m[8] * m[20])
+        + qa * (m[9] * m[21] + m[10] * m[22] + m[11] * m[23]),
+        qg * (m[6] * m[24] + m[7] * m[25] + m[8] * m[26])
+        + qa * (m[9] * m[27] + m[10] * m[28] + m[11] * m[29]),
+        qg * (m[6] * m[30] + m[7] * m[31] + m[8] * m[32])
+        + qa * (m[9] * m[33] + m[10] * m[34] + m[11] * m[35]),
+        qg * (m[6] * m[36] + m[7] * m[37] + m[8] * m[38])
+        + qa * (m[9] * m[39] + m[10] * m[40] + m[11] * m[41]),
+        qg * (m[6] * m[42] + m[7] * m[43] + m[8] * m[44])
+        + qa * (m[9] * m[45] + m[10] * m[46] + m[11] * m[47]),
+        qg * (m[6] * m[48] + m[7] * m[49] + m[8] * m[50])
+        + qa * (m[9] * m[51] + m[10] * m[52] + m[11] * m[53]),
+        qg * (m[12] * m[12] + m[13] * m[13] + m[14] * m[14])
+        + qa * (m[15] * m[15] + m[16] * m[16] + m[17] * m[17]),
+        qg * (m[12] * m[18] + m[13] * m[19] + m[14] * m[20])
+        + qa * (m[15] * m[21] + m[16] * m[22] + m[17] * m[23]),
+        qg * (m[12] * m[24] + m[13] * m[25] + m[14] * m[26])
+        + qa * (m[15] * m[27] + m[16] * m[28] + m[17] * m[29]),
+        qg * (m[12] * m[30] + m[13] * m[31] + m[14] * m[32])
+        + qa * (m[15] * m[33] + m[16] * m[34] + m[17] * m[35]),
+        qg * (m[12] * m[36] + m[13] * m[37] + m[14] * m[38])
+        + qa * (m[15] * m[39] + m[16] * m[40] + m[17] * m[41]),
+        qg * (m[12] * m[42] + m[13] * m[43] + m[14] * m[44])
+        + qa * (m[15] * m[45] + m[16] * m[46] + m[17] * m[47]),
+        qg * (m[12] * m[48] + m[13] * m[49] + m[14] * m[50])
+        + qa * (m[15] * m[51] + m[16] * m[52] + m[17] * m[53]),
+        qg * (m[18] * m[18] + m[19] * m[19] + m[20] * m[20])
+        + qa * (m[21] * m[21] + m[22] * m[22] + m[23] * m[23]),
+        qg * (m[18] * m[24] + m[19] * m[25] + m[20] * m[26])
+        + qa * (m[21] * m[27] + m[22] * m[28] + m[23] * m[29]),
+        qg * (m[18] * m[30] + m[19] * m[31] + m[20] * m[32])
+        + qa * (m[21] * m[33] + m[22] * m[34] + m[23] * m[35]),
+        qg * (m[18] * m[36] + m[19] * m[37] + m[20] * m[38])
+        + qa * (m[21] * m[39] + m[22] * m[40] + m[23] * m[41]),
+        qg * (m[18] * m[42] + m[19] * m[43] + m[20] * m[44])
+        + qa * (m[21] * m[45] + m[22] * m[46] + m[23] * m[47]),
+        qg * (m[18] * m[48] + m[19] * m[49] + m[20] * m[50])
+        + qa * (m[21] * m[51] + m[22] * m[52] + m[23] * m[53]),
+        qg * (m[24] * m[24] + m[25] * m[25] + m[26] * m[26])
+        + qa * (m[27] * m[27] + m[28] * m[28] + m[29] * m[29]),
+        qg * (m[24] * m[30] + m[25] * m[31] + m[26] * m[32])
+        + qa * (m[27] * m[33] + m[28] * m[34] + m[29] * m[35]),
+        qg * (m[24] * m[36] + m[25] * m[37] + m[26] * m[38])
+        + qa * (m[27] * m[39] + m[28] * m[40] + m[29] * m[41]),
+        qg * (m[24] * m[42] + m[25] * m[43] + m[26] * m[44])
+        + qa * (m[27] * m[45] + m[28] * m[46] + m[29] * m[47]),
+        qg * (m[24] * m[48] + m[25] * m[49] + m[26] * m[50])
+        + qa * (m[27] * m[51] + m[28] * m[52] + m[29] * m[53]),
+        qg * (m[30] * m[30] + m[31] * m[31] + m[32] * m[32])
+        + qa * (m[33] * m[33] + m[34] * m[34] + m[35] * m[35]),
+        qg * (m[30] * m[36] + m[31] * m[37] + m[32] * m[38])
+        + qa * (m[33] * m[39] + m[34] * m[40] + m[35] * m[41]),
+        qg * (m[30] * m[42] + m[31] * m[43] + m[32] * m[44])
+        + qa * (m[33] * m[45] + m[34] * m[46] + m[35] * m[47]),
+        qg * (m[30] * m[48] + m[31] * m[49] + m[32] * m[50])
+        + qa * (m[33] * m[51] + m[34] * m[52] + m[35] * m[53]),
+        qg * (m[36] * m[36] + m[37] * m[37] + m[38] * m[38])
+        + qa * (m[39] * m[39] + m[40] * m[40] + m[41] * m[41]),
+        qg * (m[36] * m[42] + m[37] * m[43] + m[38] * m[44])
+        + qa * (m[39] * m[45] + m[40] * m[46] + m[41] * m[47]),
+        qg * (m[36] * m[48] + m[37] * m[49] + m[38] * m[50])
+        + qa * (m[39] * m[51] + m[40] * m[52] + m[41] * m[53]),
+        qg * (m[42] * m[42] + m[43] * m[43] + m[44] * m[44])
+        + qa * (m[45] * m[45] + m[46] * m[46] + m[47] * m[47]),
+        qg * (m[42] * m[48] + m[43] * m[49] + m[44] * m[50])
+        + qa * (m[45] * m[51] + m[46] * m[52] + m[47] * m[53]),
+        qg * (m[48] * m[48] + m[49] * m[49] + m[50] * m[50])
+        + qa * (m[51] * m[51] + m[52] * m[52] + m[53] * m[53]),
+    )  # fmt: skip
+
+
+@helper
+def sensitivity_entries(
     kw, kx, ky, kz, kva, kvb, kvc, kpa, kpb, kpc, kt,
     aw, ax, ay, az, ava, avb, avc, apa, apb, apc, at,
     nw, nx, ny, nz, nva, nvb, nvc, npa, npb, npc, nt,
-    s00, s01, s02, s03, s04, s05,
-    s10, s11, s12, s13, s14, s15,
-    s20, s21, s22, s23, s24, s25,
-    s30, s31, s32, s33, s34, s35,
-    s40, s41, s42, s43, s44, s45,
-    s50, s51, s52, s53, s54, s55,
-    s60, s61, s62, s63, s64, s65,
-    s70, s71, s72, s73, s74, s75,
-    s80, s81, s82, s83, s84, s85,
+    s,
 ):  # fmt: skip
     """How an error of step ``k`` reaches the end of its window: ``Phi(N, k+1)
     diag(I, R_k, R_k) S_k`` (9x6), rows ``(phi, v, p)`` of the window's product ``D_N``
@@ -247,16 +337,16 @@ def preintegration_sensitivity(
     dva, dvb, dvc = nva - ava, nvb - avb, nvc - avc
     dpa, dpb, dpc = npa - apa - ava * t, npb - apb - avb * t, npc - apc - avc * t
     phw, phf = (
-        (s00, s01, s02, s10, s11, s12, s20, s21, s22),
-        (s03, s04, s05, s13, s14, s15, s23, s24, s25),
+        (s[0], s[1], s[2], s[6], s[7], s[8], s[12], s[13], s[14]),
+        (s[3], s[4], s[5], s[9], s[10], s[11], s[15], s[16], s[17]),
     )
     svw, svf = (
-        (s30, s31, s32, s40, s41, s42, s50, s51, s52),
-        (s33, s34, s35, s43, s44, s45, s53, s54, s55),
+        (s[18], s[19], s[20], s[24], s[25], s[26], s[30], s[31], s[32]),
+        (s[21], s[22], s[23], s[27], s[28], s[29], s[33], s[34], s[35]),
     )
     spw, spf = (
-        (s60, s61, s62, s70, s71, s72, s80, s81, s82),
-        (s63, s64, s65, s73, s74, s75, s83, s84, s85),
+        (s[36], s[37], s[38], s[42], s[43], s[44], s[48], s[49], s[50]),
+        (s[39], s[40], s[41], s[45], s[46], s[47], s[51], s[52], s[53]),
     )
     aw_ = mat33_mul(*ra, *phw)
     af_ = mat33_mul(*ra, *phf)
@@ -276,3 +366,77 @@ def preintegration_sensitivity(
         sub9(axpy9(t, kvw, kpw), hpw),
         sub9(axpy9(t, kvf, kpf), hpf),
     )
+
+
+@kernel(inputs=[(11,), (11,), (11,), (9, 6)], outputs=[(9, 6)])
+def preintegration_sensitivity(
+    kw, kx, ky, kz, kva, kvb, kvc, kpa, kpb, kpc, kt,
+    aw, ax, ay, az, ava, avb, avc, apa, apb, apc, at,
+    nw, nx, ny, nz, nva, nvb, nvc, npa, npb, npc, nt,
+    s00, s01, s02, s03, s04, s05,
+    s10, s11, s12, s13, s14, s15,
+    s20, s21, s22, s23, s24, s25,
+    s30, s31, s32, s33, s34, s35,
+    s40, s41, s42, s43, s44, s45,
+    s50, s51, s52, s53, s54, s55,
+    s60, s61, s62, s63, s64, s65,
+    s70, s71, s72, s73, s74, s75,
+    s80, s81, s82, s83, s84, s85,
+):  # fmt: skip
+    """``Phi(N, k+1) diag(I, R_k, R_k) S_k`` (9x6): see :func:`sensitivity_entries`."""
+    s = (
+        s00, s01, s02, s03, s04, s05,
+        s10, s11, s12, s13, s14, s15,
+        s20, s21, s22, s23, s24, s25,
+        s30, s31, s32, s33, s34, s35,
+        s40, s41, s42, s43, s44, s45,
+        s50, s51, s52, s53, s54, s55,
+        s60, s61, s62, s63, s64, s65,
+        s70, s71, s72, s73, s74, s75,
+        s80, s81, s82, s83, s84, s85,
+    )  # fmt: skip
+    return sensitivity_entries(
+        kw, kx, ky, kz, kva, kvb, kvc, kpa, kpb, kpc, kt,
+        aw, ax, ay, az, ava, avb, avc, apa, apb, apc, at,
+        nw, nx, ny, nz, nva, nvb, nvc, npa, npb, npc, nt,
+        s,
+    )  # fmt: skip
+
+
+@kernel(inputs=[(11,), (11,), (11,), (9, 6), (), ()], outputs=[(9, 6), (45,)])
+def preintegration_sensitivity_noise(
+    kw, kx, ky, kz, kva, kvb, kvc, kpa, kpb, kpc, kt,
+    aw, ax, ay, az, ava, avb, avc, apa, apb, apc, at,
+    nw, nx, ny, nz, nva, nvb, nvc, npa, npb, npc, nt,
+    s00, s01, s02, s03, s04, s05,
+    s10, s11, s12, s13, s14, s15,
+    s20, s21, s22, s23, s24, s25,
+    s30, s31, s32, s33, s34, s35,
+    s40, s41, s42, s43, s44, s45,
+    s50, s51, s52, s53, s54, s55,
+    s60, s61, s62, s63, s64, s65,
+    s70, s71, s72, s73, s74, s75,
+    s80, s81, s82, s83, s84, s85,
+    qg, qa,
+):  # fmt: skip
+    """:func:`preintegration_sensitivity` ``M`` and the step's covariance share
+    ``M diag(qg I, qa I) M^T`` (upper triangle, 45 entries), ``qg``, ``qa`` the
+    discrete noise variances of the step's gyro and accelerometer inputs."""
+    s = (
+        s00, s01, s02, s03, s04, s05,
+        s10, s11, s12, s13, s14, s15,
+        s20, s21, s22, s23, s24, s25,
+        s30, s31, s32, s33, s34, s35,
+        s40, s41, s42, s43, s44, s45,
+        s50, s51, s52, s53, s54, s55,
+        s60, s61, s62, s63, s64, s65,
+        s70, s71, s72, s73, s74, s75,
+        s80, s81, s82, s83, s84, s85,
+    )  # fmt: skip
+    m = sensitivity_entries(
+        kw, kx, ky, kz, kva, kvb, kvc, kpa, kpb, kpc, kt,
+        aw, ax, ay, az, ava, avb, avc, apa, apb, apc, at,
+        nw, nx, ny, nz, nva, nvb, nvc, npa, npb, npc, nt,
+        s,
+    )  # fmt: skip
+    return m + weighted_gram45(m, qg, qa)
