@@ -312,6 +312,45 @@ def test_associate_by_hand():
         associate(ref, est, max_diff=0.01, offset=100.0)
 
 
+@pytest.mark.parametrize("seed", range(4))
+def test_nearest_pairs_compiled_and_numpy_agree_with_brute_force(seed):
+    """The compiled merge, the NumPy binary search and a brute-force argmin
+    (np.argmin takes the first of equal minima: the earlier stamp on a tie)."""
+    import importlib
+
+    from rigidkit._engine import drain, numba_available
+    from rigidkit.applications.trajectory import _loops
+
+    assoc = importlib.import_module("rigidkit.applications.trajectory.associate")
+
+    rng = np.random.default_rng(seed)
+    # Stamps on a grid of 1/8 s make exact ties (a stamp halfway between two).
+    long = np.unique(rng.integers(0, 400, 150)) / 8.0
+    short = np.unique(rng.integers(-10, 420, 60)) / 8.0 + rng.choice([0.0, 1 / 16], 1)
+    short = short[: rng.integers(1, len(short) + 1)]
+    max_diff = 1 / 16
+    gap = np.abs(long[None, :] - short[:, None])
+    near = np.argmin(gap, axis=1)
+    keep = gap[np.arange(len(short)), near] <= max_diff
+    expected = (np.flatnonzero(keep), near[keep])
+    numpy_pairs = assoc._nearest_numpy(short, long, max_diff)
+    for got in (numpy_pairs, assoc.nearest_pairs(short, long, max_diff)):
+        np.testing.assert_array_equal(got[0], expected[0])
+        np.testing.assert_array_equal(got[1], expected[1])
+    if numba_available():
+        _loops.nearest_loop()
+        drain()
+        assert _loops.nearest_loop() is not None
+        i_s, i_l, strict = assoc._pairs(short, long, max_diff)
+        np.testing.assert_array_equal(i_s, expected[0])
+        np.testing.assert_array_equal(i_l, expected[1])
+        assert strict == bool((np.diff(expected[1]) > 0).all())
+        # ref the longer one: the pairs come back as (i_ref, i_est).
+        i_l2, i_s2, _ = assoc._pairs(long, short, max_diff)
+        np.testing.assert_array_equal(i_s2, expected[0])
+        np.testing.assert_array_equal(i_l2, expected[1])
+
+
 def test_associate_interpolate():
     x = np.arange(5.0)
     ref = _line(2 * x)

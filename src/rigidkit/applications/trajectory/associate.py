@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import TimestampError
+from ._loops import nearest_loop
 from .trajectory import Trajectory
 
 __all__ = ["associate", "nearest_pairs"]
@@ -23,11 +24,39 @@ def nearest_pairs(ref_stamps, est_stamps, max_diff):
     >>> nearest_pairs(np.array([0.0, 1.0, 2.0]), np.array([0.004, 1.1, 2.0, 3.0]), 0.01)
     (array([0, 2]), array([0, 2]))
     """
+    i_ref, i_est, _ = _pairs(ref_stamps, est_stamps, max_diff)
+    return i_ref, i_est
+
+
+def _pairs(ref_stamps, est_stamps, max_diff):
+    """:func:`nearest_pairs` and whether both index arrays are known to be
+    strictly increasing (no pose of the longer trajectory used twice)."""
     short_is_ref = len(ref_stamps) <= len(est_stamps)
     short, long = (ref_stamps, est_stamps) if short_is_ref else (est_stamps, ref_stamps)
     if len(short) == 0 or len(long) == 0:
         empty = np.zeros(0, dtype=np.intp)
-        return empty, empty
+        return empty, empty, True
+    loop = nearest_loop()
+    if loop is not None:
+        i_short = np.empty(len(short), dtype=np.int64)
+        i_long = np.empty(len(short), dtype=np.int64)
+        k, repeats = loop(
+            np.ascontiguousarray(long, dtype=np.float64),
+            np.ascontiguousarray(short, dtype=np.float64),
+            float(max_diff),
+            i_short,
+            i_long,
+        )
+        i_short, i_long, strict = i_short[:k], i_long[:k], repeats == 0
+    else:
+        i_short, i_long = _nearest_numpy(short, long, max_diff)
+        strict = False  # not known: checked where it matters
+    return (i_short, i_long, strict) if short_is_ref else (i_long, i_short, strict)
+
+
+def _nearest_numpy(short, long, max_diff):
+    """The "nearest" rule with NumPy (until the compiled loop is ready, or
+    without numba): a binary search per stamp of ``short``."""
     hi = np.clip(np.searchsorted(long, short), 1, len(long) - 1) if len(long) > 1 else None
     if hi is None:
         near = np.zeros(len(short), dtype=np.intp)
@@ -36,16 +65,16 @@ def nearest_pairs(ref_stamps, est_stamps, max_diff):
         # The earlier of two equally near stamps, as a first-minimum search gives.
         near = np.where(np.abs(long[lo] - short) <= np.abs(long[hi] - short), lo, hi)
     keep = np.abs(long[near] - short) <= max_diff
-    i_short = np.flatnonzero(keep)
-    i_long = near[keep]
-    return (i_short, i_long) if short_is_ref else (i_long, i_short)
+    return np.flatnonzero(keep), near[keep]
 
 
-def _take(traj, idx):
+def _take(traj, idx, strict=False):
     """The poses at the non-decreasing indices ``idx``; a view where they are a
-    run of consecutive indices (a million poses are 56 MB to copy)."""
+    run of consecutive indices (a million poses are 56 MB to copy). ``strict``:
+    ``idx`` is known to be strictly increasing, so spanning ``len(idx)`` indices
+    makes it consecutive."""
     a, b = int(idx[0]), int(idx[-1]) + 1
-    if b - a == len(idx) and (len(idx) < 2 or bool((np.diff(idx) == 1).all())):
+    if b - a == len(idx) and (strict or len(idx) < 2 or bool((np.diff(idx) == 1).all())):
         idx = slice(a, b)
     return Trajectory._trusted(traj.stamps[idx], traj.poses[..., idx])
 
@@ -104,11 +133,12 @@ def associate(ref, est, max_diff=0.01, offset=0.0, method="nearest", max_gap=Non
         if traj.stamps is None:
             raise TimestampError(f"{name} has no stamps to associate by")
     t_ref = ref.stamps
-    t_est = est.stamps + float(offset)
+    # Without an offset, no copy of the stamps (8 MB for a million poses).
+    t_est = est.stamps + float(offset) if float(offset) != 0.0 else est.stamps
     if method == "nearest":
-        i_ref, i_est = nearest_pairs(t_ref, t_est, float(max_diff))
+        i_ref, i_est, strict = _pairs(t_ref, t_est, float(max_diff))
         if len(i_ref):
-            return _take(ref, i_ref), _take(est, i_est)
+            return _take(ref, i_ref, strict), _take(est, i_est, strict)
     elif method == "interpolate":
         keep = (t_est >= t_ref[0]) & (t_est <= t_ref[-1]) if len(t_ref) else t_est < 0
         if max_gap is not None and len(t_ref) > 1:
