@@ -208,3 +208,118 @@ def test_torch_poses_give_the_numpy_numbers():
             rk.trajectory.ape(ref, est, relation=relation).errors,
             rtol=1e-12,
         )
+
+
+def _screw_keys(n=7, seed=3):
+    """Poses with sizeable rotations between stamps (rotation vectors, positions)."""
+    rng = np.random.default_rng(seed)
+    return rng.normal(0, 0.6, (n, 3)), rng.normal(0, 2.0, (n, 3))
+
+
+@pytest.mark.parametrize("method", ["slerp", "linear"])
+def test_torch_and_jax_trajectories_keep_their_namespace(torch, jnp, method):
+    rv, p = _screw_keys()
+    t = np.array([0.0, 0.4, 1.0, 1.7, 2.0, 3.1, 4.0])
+    q = np.array([0.1, 0.4, 1.35, 2.999, 4.0])
+    ref = rk.Trajectory(t, rk.Transform(rk.Rotation.from_rotvec(rv), p))
+    for xp in (torch, jnp):
+        traj = rk.Trajectory(
+            t, rk.Transform(rk.Rotation.from_rotvec(xp.asarray(rv)), xp.asarray(p))
+        )
+        at = traj.at(q, method=method)
+        assert type(at.positions) is type(traj.positions)
+        np.testing.assert_allclose(
+            np.asarray(at.positions), ref.at(q, method=method).positions, rtol=1e-13
+        )
+        np.testing.assert_allclose(
+            np.asarray(at.poses.rotation.as_matrix()),
+            ref.at(q, method=method).poses.rotation.as_matrix(),
+            rtol=1e-13,
+            atol=1e-15,
+        )
+        length = traj.path_length
+        assert type(length) is type(traj.positions) and length.shape == ()
+        assert float(length) == pytest.approx(ref.path_length, rel=1e-14)
+        v = traj.velocities(frame="body")
+        assert type(v) is type(traj.positions)
+        np.testing.assert_allclose(
+            np.asarray(v), ref.velocities(frame="body"), rtol=1e-12, atol=1e-14
+        )
+        S = rk.Similarity(scale=1.5, rotation=rk.Rotation.from_rotvec([0, 0.3, 0]))
+        moved = traj.transform(S)
+        assert type(moved.positions) is type(traj.positions)
+        np.testing.assert_allclose(
+            np.asarray(moved.positions), ref.transform(S).positions, rtol=1e-13
+        )
+
+
+def test_torch_and_jax_batched_at_keeps_the_time_axis(torch, jnp):
+    rv, p = _screw_keys(n=5)
+    rv2, p2 = _screw_keys(n=5, seed=4)
+    t = np.arange(5.0)
+    rvb, pb = np.stack([rv, rv2]), np.stack([p, p2])
+    ref = rk.Trajectory(t, rk.Transform(rk.Rotation.from_rotvec(rvb), pb))
+    q = np.array([0.5, 2.25, 3.75])
+    for xp in (torch, jnp):
+        traj = rk.Trajectory(
+            t, rk.Transform(rk.Rotation.from_rotvec(xp.asarray(rvb)), xp.asarray(pb))
+        )
+        at = traj.at(q)
+        assert at.shape == (2, 3) and type(at.positions) is type(traj.positions)
+        np.testing.assert_allclose(
+            np.asarray(at.positions), ref.at(q).positions, rtol=1e-13
+        )
+
+
+@pytest.mark.parametrize("method", ["slerp", "linear"])
+def test_torch_autograd_through_at_matches_finite_differences(torch, method):
+    """d(sum of interpolated positions . w)/d(rotation vectors, positions) by
+    torch's autograd against central differences of the NumPy computation."""
+    rv, p = _screw_keys(n=5)
+    t = np.array([0.0, 0.5, 1.5, 2.0, 3.0])
+    q = np.array([0.2, 0.9, 1.6, 2.7])
+    w = np.random.default_rng(1).normal(size=(len(q), 3))
+
+    def f(rv, p):
+        traj = rk.Trajectory(t, rk.Transform(rk.Rotation.from_rotvec(rv), p))
+        return float(np.sum(traj.at(q, method=method).positions * w))
+
+    rv_t = torch.tensor(rv, requires_grad=True)
+    p_t = torch.tensor(p, requires_grad=True)
+    traj = rk.Trajectory(t, rk.Transform(rk.Rotation.from_rotvec(rv_t), p_t))
+    value = (traj.at(q, method=method).positions * torch.tensor(w)).sum()
+    assert float(value.detach()) == pytest.approx(f(rv, p), rel=1e-13)
+    value.backward()
+    h = 1e-6
+    for x, grad in ((rv, rv_t.grad.numpy()), (p, p_t.grad.numpy())):
+        fd = np.zeros_like(x)
+        for idx in np.ndindex(x.shape):
+            up, down = x.copy(), x.copy()
+            up[idx] += h
+            down[idx] -= h
+            args = (up, p) if x is rv else (rv, up)
+            args_down = (down, p) if x is rv else (rv, down)
+            fd[idx] = (f(*args) - f(*args_down)) / (2 * h)
+        # Central differences: O(h^2) truncation plus ~1e-16 / h rounding.
+        np.testing.assert_allclose(grad, fd, rtol=1e-7, atol=1e-8)
+    # The screw motion moves the positions with the rotations; "linear" does not.
+    assert (np.abs(rv_t.grad.numpy()).max() > 0.1) == (method == "slerp")
+
+
+def test_metrics_of_torch_and_jax_poses_are_numpy_float64(torch, jnp):
+    """ape and rpe compute in NumPy: poses that require grad (or live in JAX)
+    give NumPy float64 errors equal to the NumPy poses' errors."""
+    a, b = rk.Transform.random(9, rng=7), rk.Transform.random(9, rng=8)
+    t = np.arange(9.0)
+    ref, est = rk.Trajectory(t, a), rk.Trajectory(t, b)
+    for make in (lambda x: torch.tensor(x, requires_grad=True), jnp.asarray):
+        ref_x = rk.Trajectory(t, rk.Transform.from_pq(make(a.as_pq())))
+        est_x = rk.Trajectory(t, rk.Transform.from_pq(make(b.as_pq())))
+        for metric in (rk.trajectory.ape, rk.trajectory.rpe):
+            for relation in ("translation", "rotation_angle", "point_distance"):
+                got = metric(ref_x, est_x, relation=relation)
+                assert isinstance(got.errors, np.ndarray)
+                assert got.errors.dtype == np.float64
+                np.testing.assert_allclose(
+                    got.errors, metric(ref, est, relation=relation).errors, rtol=1e-12
+                )

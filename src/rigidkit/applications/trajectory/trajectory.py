@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..._engine.namespace import is_torch, namespace_of
 from ...errors import OutOfRangeError, ShapeError, TimestampError
 from ...objects.similarity import Similarity
 from ...objects.transform import Transform
@@ -12,6 +13,17 @@ from ..kinematics import twist_from_samples
 from ..splines import BSplineSE3
 
 __all__ = ["Trajectory", "check_stamps"]
+
+
+def _moveaxis(x, source: int, destination: int):
+    """``np.moveaxis`` for an array of any namespace (NumPy, torch, JAX)."""
+    if isinstance(x, np.ndarray):
+        return np.moveaxis(x, source, destination)
+    perm = list(range(x.ndim))
+    perm.insert(destination % x.ndim, perm.pop(source % x.ndim))
+    if is_torch(x):
+        return x.permute(*perm)
+    return namespace_of(x).permute_dims(x, tuple(perm))
 
 
 def check_stamps(stamps, n: int, what: str = "stamps") -> np.ndarray:
@@ -174,9 +186,15 @@ class Trajectory:
     def path_length(self):
         """Length of the polyline through the positions: ``sum |p_{i+1} - p_i|``.
 
-        A float for one trajectory, an array of shape (...) for a batch.
+        A float for one trajectory, an array of shape (...) for a batch; for
+        poses on torch or JAX, an array of their namespace (0-d for one
+        trajectory), which autograd follows.
         """
-        p = np.asarray(self.positions)
+        p = self.positions
+        if not isinstance(p, np.ndarray):  # torch, JAX: in their namespace (autograd)
+            xp = namespace_of(p)
+            step = p[..., 1:, :] - p[..., :-1, :]
+            return xp.sum(xp.sqrt(xp.sum(step * step, axis=-1)), axis=-1)
         total = np.linalg.norm(np.diff(p, axis=-2), axis=-1).sum(axis=-1)
         return float(total) if total.ndim == 0 else total
 
@@ -229,7 +247,13 @@ class Trajectory:
             )
         lead = self.shape[:-1]
         # Slerp and the spline take the time axis first.
-        keys = Transform.from_pq(np.moveaxis(np.asarray(self._poses.as_pq()), -2, 0))
+        # The poses stay in their namespace (torch, JAX): Slerp takes NumPy times
+        # and interpolates keyframes of any namespace, autograd included.
+        keys = (
+            Transform.from_pq(_moveaxis(self._poses.as_pq(), -2, 0))
+            if lead
+            else self._poses
+        )
         if method in ("slerp", "linear"):
             out = Slerp(t, keys, decoupled=method == "linear")(q)
         elif method == "spline":
@@ -246,8 +270,9 @@ class Trajectory:
             raise ValueError(
                 f"method must be 'slerp', 'linear' or 'spline', got {method!r}"
             )
-        pq = np.moveaxis(np.asarray(out.as_pq()), 0, -2) if lead else out.as_pq()
-        return Trajectory._trusted(q, Transform.from_pq(pq))
+        if lead:
+            out = Transform.from_pq(_moveaxis(out.as_pq(), 0, -2))
+        return Trajectory._trusted(q, out)
 
     def transform(self, S):
         """Every pose left-multiplied by ``S``: ``S @ T_i`` (a change of world frame).
@@ -284,4 +309,7 @@ class Trajectory:
         where there are none): ``frame="body"`` gives ``vee(T^-1 dT/dt)``,
         ``"world"`` ``vee(dT/dt T^-1)``.
         """
-        return twist_from_samples(self._poses, self._times(), frame=frame)
+        t = self._times()
+        if not isinstance(self._poses.translation, np.ndarray):
+            t = np.array(t)  # writable: torch warns on a read-only NumPy array
+        return twist_from_samples(self._poses, t, frame=frame)
