@@ -70,6 +70,8 @@ PUBLIC_MODULES = {
     "symbolic": "rigidkit.applications.symbolic",
     "kinematics": "rigidkit.applications.kinematics",
     "inertial": "rigidkit.applications.inertial",
+    "trajectory": "rigidkit.applications.trajectory",
+    "io": "rigidkit.applications.io",
     "jacobians": "rigidkit.applications.jacobians",
     "cli": "rigidkit.applications.cli",
 }
