@@ -343,19 +343,20 @@ def _preintegrate(w, f, h, bg, ba, noise, method, xp):
     D = running_steps(inc)
     end = D[..., -1:, :]
     first, after = D[..., :-1, :], D[..., 1:, :]
-    cov = None
-    if noise is None:
-        M = _kj.preintegration_sensitivity(first, after, end, S)
-    else:
-        # The discrete variances sigma^2 / h of each step (eq. 45); a step of zero
-        # duration (padding) has M = 0 and adds nothing.
-        hh = h if len(h.shape) else h + 0.0 * wc[..., 0]
-        safe = xp.where(hh > 0, hh, 1.0)
-        inv = xp.where(hh > 0, 1.0 / safe, 0.0)
-        qg = noise.gyro_noise_density**2 * inv
-        qa = noise.accel_noise_density**2 * inv
-        M, C = _kj.preintegration_sensitivity_noise(first, after, end, S, qg, qa)
-        cov = _symmetric(xp.sum(C, axis=-2), xp)  # each step's share, summed
+    # The discrete variances sigma^2 / h of each step (eq. 45); a step of zero
+    # duration (padding) has M = 0 and adds nothing.
+    hh = h if len(h.shape) else h + 0.0 * wc[..., 0]
+    safe = xp.where(hh > 0, hh, 1.0)
+    inv = xp.where(hh > 0, 1.0 / safe, 0.0)
+    sg, sa = (
+        (0.0, 0.0)
+        if noise is None
+        else (noise.gyro_noise_density, noise.accel_noise_density)
+    )
+    M, C = _kj.preintegration_sensitivity(
+        first, after, end, S, sg * sg * inv, sa * sa * inv
+    )
+    cov = None if noise is None else _symmetric(xp.sum(C, axis=-2), xp)
     J = -xp.sum(M, axis=-3)
     batch = tuple(J.shape[:-2])
     bg = xp.broadcast_to(bg, batch + (3,))

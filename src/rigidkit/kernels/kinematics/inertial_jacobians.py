@@ -368,43 +368,8 @@ def sensitivity_entries(
     )
 
 
-@kernel(inputs=[(11,), (11,), (11,), (9, 6)], outputs=[(9, 6)])
-def preintegration_sensitivity(
-    kw, kx, ky, kz, kva, kvb, kvc, kpa, kpb, kpc, kt,
-    aw, ax, ay, az, ava, avb, avc, apa, apb, apc, at,
-    nw, nx, ny, nz, nva, nvb, nvc, npa, npb, npc, nt,
-    s00, s01, s02, s03, s04, s05,
-    s10, s11, s12, s13, s14, s15,
-    s20, s21, s22, s23, s24, s25,
-    s30, s31, s32, s33, s34, s35,
-    s40, s41, s42, s43, s44, s45,
-    s50, s51, s52, s53, s54, s55,
-    s60, s61, s62, s63, s64, s65,
-    s70, s71, s72, s73, s74, s75,
-    s80, s81, s82, s83, s84, s85,
-):  # fmt: skip
-    """``Phi(N, k+1) diag(I, R_k, R_k) S_k`` (9x6): see :func:`sensitivity_entries`."""
-    s = (
-        s00, s01, s02, s03, s04, s05,
-        s10, s11, s12, s13, s14, s15,
-        s20, s21, s22, s23, s24, s25,
-        s30, s31, s32, s33, s34, s35,
-        s40, s41, s42, s43, s44, s45,
-        s50, s51, s52, s53, s54, s55,
-        s60, s61, s62, s63, s64, s65,
-        s70, s71, s72, s73, s74, s75,
-        s80, s81, s82, s83, s84, s85,
-    )  # fmt: skip
-    return sensitivity_entries(
-        kw, kx, ky, kz, kva, kvb, kvc, kpa, kpb, kpc, kt,
-        aw, ax, ay, az, ava, avb, avc, apa, apb, apc, at,
-        nw, nx, ny, nz, nva, nvb, nvc, npa, npb, npc, nt,
-        s,
-    )  # fmt: skip
-
-
 @kernel(inputs=[(11,), (11,), (11,), (9, 6), (), ()], outputs=[(9, 6), (45,)])
-def preintegration_sensitivity_noise(
+def preintegration_sensitivity(
     kw, kx, ky, kz, kva, kvb, kvc, kpa, kpb, kpc, kt,
     aw, ax, ay, az, ava, avb, avc, apa, apb, apc, at,
     nw, nx, ny, nz, nva, nvb, nvc, npa, npb, npc, nt,
@@ -419,9 +384,10 @@ def preintegration_sensitivity_noise(
     s80, s81, s82, s83, s84, s85,
     qg, qa,
 ):  # fmt: skip
-    """:func:`preintegration_sensitivity` ``M`` and the step's covariance share
-    ``M diag(qg I, qa I) M^T`` (upper triangle, 45 entries), ``qg``, ``qa`` the
-    discrete noise variances of the step's gyro and accelerometer inputs."""
+    """``M = Phi(N, k+1) diag(I, R_k, R_k) S_k`` (9x6, :func:`sensitivity_entries`) and
+    the step's covariance share ``M diag(qg I, qa I) M^T`` (upper triangle, 45
+    entries), ``qg``, ``qa`` the discrete noise variances of the step's gyro and
+    accelerometer inputs (0 for no covariance)."""
     s = (
         s00, s01, s02, s03, s04, s05,
         s10, s11, s12, s13, s14, s15,
