@@ -253,6 +253,17 @@ class Snapshot:
             cov = (1.0 - w) * self.cov[i] + w * self.cov[i + 1]
         return T, cov
 
+    def premultiplied(self, S):
+        """This edge with samples ``S T_i`` (``S`` a single ``Transform``): the same
+        stamps and names (so the same errors), kept for the last ``S`` asked."""
+        kept = self._inc.get("premultiplied")
+        if kept is not None and kept[0] is S:
+            return kept[1]
+        pq = registry.stored(S @ wrap_pq(self.pq))
+        snap = Snapshot(self.parent, self.child, self.t, pq, None)
+        self._inc["premultiplied"] = (S, snap)  # one tuple: consistent for threads
+        return snap
+
     def increments(self, interpolation):
         """Per-segment tables, computed once per snapshot (many times on one
         snapshot share them): ``log(T_i^-1 T_{i+1})`` (N - 1, 6) for ``"screw"``,
