@@ -275,6 +275,18 @@ def test_torch_and_jax(torch, jax, jnp, rng):
         jnp.asarray(w), jnp.asarray(f)
     )
     np.testing.assert_allclose(np.asarray(out), ref.delta_p, atol=1e-13)
+    # Covariance, correction and residual on both, against NumPy's.
+    noise = rk.inertial.ImuNoise(1e-3, 1e-2)
+    want = rk.inertial.preintegrate(w, f, 0.02, noise=noise)
+    Xi, Xj = rk.ExtendedPose.random(2, rng)
+    r0 = want.residual(Xi, Xj, gyro_bias=[0.01, 0.0, 0.0])
+    for xp in (torch.tensor, jnp.asarray):
+        got = rk.inertial.preintegrate(xp(w), xp(f), 0.02, noise=noise)
+        np.testing.assert_allclose(np.asarray(got.covariance), want.covariance, atol=1e-18)
+        A, B = (rk.ExtendedPose._wrap(xp(np.asarray(X._data))) for X in (Xi, Xj))
+        r = got.residual(A, B, gyro_bias=xp(np.array([0.01, 0.0, 0.0])))
+        for a, b in zip(r, r0, strict=True):
+            np.testing.assert_allclose(np.asarray(a), b, atol=1e-14)
 
 
 def _gtsam_pim(gtsam, w, f, h, sg, sa):

@@ -228,9 +228,8 @@ class Preintegrated:
 
 
 def _swap(M):
-    xp = namespace_of(M)
-    nd = len(M.shape)
-    return xp.permute_dims(M, tuple(range(nd - 2)) + (nd - 1, nd - 2))
+    """The transposes of a stack of matrices (``.mT``: NumPy, torch and JAX alike)."""
+    return M.mT
 
 
 def _mv(M, v):
@@ -377,7 +376,7 @@ def _symmetric(upper, xp):
     idx = _FULL.reshape(-1)
     if not is_numpy(xp):
         idx = xp.asarray(idx, device=device_of(upper))
-    full = xp.take(upper, idx, axis=-1)
+    full = upper[..., idx]  # (integer-array indexing: NumPy, torch and JAX alike)
     return xp.reshape(full, tuple(upper.shape[:-1]) + (9, 9))
 
 
