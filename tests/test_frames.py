@@ -202,15 +202,19 @@ def test_many_times_in_blocks(robot, monkeypatch, interpolation):
     lo, hi = max(s1[0], s2[0]), min(s1[-1], s2[-1])
     rule = decoupled_reference if interpolation == "decoupled" else screw_reference
     times = rng.uniform(lo, hi, 700)
-    g.get("tag", "camera", at=times, interpolation=interpolation)
-    drain()  # exact equality: the compiled loops (see the test above)
-    for at in (times, np.sort(times)):
-        monkeypatch.setattr(lookup, "BLOCK", 10**9)
-        whole = g.get("tag", "camera", at=at, interpolation=interpolation)
-        monkeypatch.setattr(lookup, "BLOCK", 64)
-        blocks = g.get("tag", "camera", at=at, interpolation=interpolation)
-        np.testing.assert_array_equal(blocks.as_matrix(), whole.as_matrix())
-        np.testing.assert_allclose(blocks.as_matrix(), explicit(data, at, rule), atol=1e-10)
+    map_T_tag = matrices(data["map", "tag"][1])[0]
+    # across the common ancestor, and up to it (the last compose writes the rows)
+    for target, left in (("tag", np.eye(4)), ("map", map_T_tag)):
+        g.get(target, "camera", at=times, interpolation=interpolation)
+        drain()  # exact equality: the compiled loops (see the test above)
+        for at in (times, np.sort(times)):
+            monkeypatch.setattr(lookup, "BLOCK", 10**9)
+            whole = g.get(target, "camera", at=at, interpolation=interpolation)
+            monkeypatch.setattr(lookup, "BLOCK", 64)
+            blocks = g.get(target, "camera", at=at, interpolation=interpolation)
+            np.testing.assert_array_equal(blocks.as_matrix(), whole.as_matrix())
+            want = left @ explicit(data, at, rule)
+            np.testing.assert_allclose(blocks.as_matrix(), want, atol=1e-10)
     bad = times.copy()
     bad[10], bad[500] = hi + 1.0, lo - 1.0
     with pytest.raises(rk.ExtrapolationError) as err:

@@ -15,6 +15,7 @@ import math
 import numpy as np
 
 from ...errors import ExtrapolationError
+from ...kernels.se3 import pose_compose as _pose_compose
 from ...objects import registry
 from ...objects.transform import Transform
 from .buffer import wrap_pq
@@ -185,6 +186,7 @@ def _compose_blocks(items_s, items_t, q, interpolation, extrapolate):
     times = [None if type(it) is Transform else it.check(q, extrapolate) for it in items]
     out = np.empty((m, 7))
     ns = len(items_s)
+    last = len(items) - 1 if not items_t else None
     for lo in range(0, m, BLOCK):
         hi = min(lo + BLOCK, m)
         chains = [None, None]
@@ -192,8 +194,15 @@ def _compose_blocks(items_s, items_t, q, interpolation, extrapolate):
             if tk is not None:
                 it = it.at(tk[lo:hi], interpolation, many=m)[0]
             c = 0 if k < ns else 1
+            if k == last and chains[0] is not None:
+                # target is an ancestor of source: the last compose writes the rows
+                _pose_compose(
+                    registry.stored(chains[0]), registry.stored(it), out=out[lo:hi]
+                )
+                break
             chains[c] = it if chains[c] is None else chains[c] @ it
-        out[lo:hi] = registry.stored(_link(*chains))
+        else:
+            out[lo:hi] = registry.stored(_link(*chains))
     return wrap_pq(out)
 
 
