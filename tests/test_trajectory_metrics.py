@@ -482,3 +482,14 @@ def test_statistics_equal_numpy(n):
     )
     batch = rk.trajectory.statistics(np.stack([e, 2 * e]))
     np.testing.assert_allclose(batch["rmse"], [s["rmse"], 2 * s["rmse"]], rtol=1e-14)
+
+
+@pytest.mark.parametrize("special", [np.nan, np.inf])
+def test_statistics_min_max_with_a_nan_or_inf_as_numpy(special):
+    e = np.abs(np.random.default_rng(3).normal(size=10))
+    e[4] = special
+    kept = e.copy()
+    with np.errstate(invalid="ignore"):  # the deviations: inf - inf
+        s = rk.trajectory.statistics(e)
+    np.testing.assert_array_equal(e, kept)  # the errors are not reordered
+    np.testing.assert_equal([s["min"], s["max"]], [e.min(), e.max()])
