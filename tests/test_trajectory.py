@@ -216,7 +216,7 @@ def _screw_keys(n=7, seed=3):
     return rng.normal(0, 0.6, (n, 3)), rng.normal(0, 2.0, (n, 3))
 
 
-@pytest.mark.parametrize("method", ["slerp", "linear"])
+@pytest.mark.parametrize("method", ["slerp", "linear", "spline"])
 def test_torch_and_jax_trajectories_keep_their_namespace(torch, jnp, method):
     rv, p = _screw_keys()
     t = np.array([0.0, 0.4, 1.0, 1.7, 2.0, 3.1, 4.0])

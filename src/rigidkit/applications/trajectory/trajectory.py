@@ -229,6 +229,13 @@ class Trajectory:
             it approximates the poses (a cubic B-spline does not pass through
             its control points).
 
+        Returns
+        -------
+        Trajectory
+            Stamped ``times``; its poses in the namespace of this trajectory's
+            (torch, JAX: autograd follows them; the times and the search for
+            their intervals stay NumPy float64).
+
         Raises
         ------
         OutOfRangeError
