@@ -493,3 +493,21 @@ def test_statistics_min_max_with_a_nan_or_inf_as_numpy(special):
         s = rk.trajectory.statistics(e)
     np.testing.assert_array_equal(e, kept)  # the errors are not reordered
     np.testing.assert_equal([s["min"], s["max"]], [e.min(), e.max()])
+
+
+@pytest.mark.parametrize("n", [5, 16384 * 3 + 17])
+def test_position_distances_in_blocks_equal_the_norm(n):
+    """The blocked pass (above 16,384 rows) and the whole-array one, on strided
+    views into 7-number poses as Transform stores them, against np.linalg.norm."""
+    import importlib
+
+    metrics = importlib.import_module("rigidkit.applications.trajectory.metrics")
+    rng = np.random.default_rng(n)
+    a, b = rng.normal(size=(n, 7)), rng.normal(size=(n, 7))
+    got = metrics._distance(a[:, :3], b[:, :3])
+    expected = np.linalg.norm(a[:, :3] - b[:, :3], axis=-1)
+    np.testing.assert_allclose(got, expected, rtol=1e-15)
+    # A batch broadcasting against one trajectory.
+    batch = metrics._distance(np.stack([a[:, :3], b[:, :3]]), b[:, :3])
+    np.testing.assert_allclose(batch[0], expected, rtol=1e-15)
+    np.testing.assert_array_equal(batch[1], 0.0)

@@ -33,6 +33,13 @@ UNITS = ("frames", "meters", "degrees", "radians")
 _SQRT8 = np.sqrt(8.0)
 
 
+def _sum_of_squares(x) -> float:
+    """``x . x`` of a 1-D array: a BLAS dot up to 10,000 numbers (~1 us), einsum's
+    single-threaded loop above, where OpenBLAS starts threads that make a dot of
+    a million take 16 ms instead of 0.3 ms on a loaded machine."""
+    return float(x @ x) if x.shape[0] <= 10_000 else float(np.einsum("i,i->", x, x))
+
+
 def statistics(errors) -> dict:
     """``rmse, mean, median, std, min, max, sse`` of ``errors`` (last axis), floats.
 
@@ -49,9 +56,8 @@ def statistics(errors) -> dict:
     if e.ndim == 1:
         # One pass per number: np.median, np.std and friends cost ~20 us each in
         # overhead at a few thousand errors, more than the metric. The sums of
-        # squares are einsum's, not BLAS dots (``e @ e``): OpenBLAS's threads
-        # make a dot of a million take 16 ms instead of 0.3 ms on a loaded machine.
-        sse = float(np.einsum("i,i->", e, e))
+        # squares: see _sum_of_squares.
+        sse = _sum_of_squares(e)
         mean = float(e.sum()) / n
         half = n // 2
         # One kth: partitioning at two costs ~7x more; the lower middle is then
@@ -69,7 +75,7 @@ def statistics(errors) -> dict:
             "rmse": float(np.sqrt(sse / n)),
             "mean": mean,
             "median": median,
-            "std": float(np.sqrt(np.einsum("i,i->", d, d) / n)),
+            "std": float(np.sqrt(_sum_of_squares(d) / n)),
             "min": lo,
             "max": hi,
             "sse": sse,
@@ -160,7 +166,9 @@ def _distance(a, b, block=16384):
     written to memory (a million poses: 22 ms instead of 38 ms for whole-array
     passes, whose temporaries of 8-24 MB each go through memory).
     """
-    a, b = np.broadcast_arrays(np.asarray(a), np.asarray(b))
+    a, b = np.asarray(a), np.asarray(b)
+    if a.shape != b.shape or a.size <= 3 * block:
+        return _distance_whole(a, b)
     lead = a.shape[:-1]
     a, b = a.reshape(-1, 3), b.reshape(-1, 3)  # views where the layout allows
     n = a.shape[0]
@@ -174,6 +182,21 @@ def _distance(a, b, block=16384):
         np.add(dd[:, 0], dd[:, 1], out=o)
         o += dd[:, 2]
     return np.sqrt(out, out=out).reshape(lead)
+
+
+def _distance_whole(a, b):
+    """``|a - b|`` over the last axis (3) in whole-array passes, one per column
+    (NumPy's loops over an axis of 3 cost ~10x more): for a few thousand rows,
+    which fit in cache, and for batches that broadcast."""
+    out = a[..., 0] - b[..., 0]
+    out *= out
+    d = a[..., 1] - b[..., 1]
+    d *= d
+    out += d
+    np.subtract(a[..., 2], b[..., 2], out=d)
+    d *= d
+    out += d
+    return np.sqrt(out, out=out)
 
 
 def _norm(v):
