@@ -1435,3 +1435,38 @@ def test_setup_of_libraries_imported_before_rigidkit():
         """
     )
     assert out == "ok"
+
+
+def test_numba_error_messages_leave_the_callers_stdout_alone():
+    """numba formats the typing errors it recovers from during a compile; with
+    colorama installed it did so inside ``colorama.init()``/``deinit()``, which save
+    ``sys.stdout``/``sys.stderr`` and put the saved streams back: on the compile
+    thread, a redirection the caller made in between (``redirect_stdout``,
+    ``capsys``, a doctest) was undone, and its output lost (CLI tests read nothing,
+    doctests "Got nothing", on a cold cache). After the engine's thread has
+    imported numba, its messages are plain text, formatted without colorama, and
+    the caller's stream stays."""
+    if not numba_backend.available():
+        pytest.skip("needs numba")
+    pytest.importorskip("colorama")
+    out = _fresh(
+        """
+        import io, sys
+        import rigidkit as rk
+        from rigidkit._engine import numba_backend
+        R = rk.Rotation.random(2000, rng=0)
+        R @ R  # a batch: the engine's thread starts, imports numba, builds the loop
+        numba_backend.drain(timeout=120)
+        import numba
+        from numba.core import errors
+        mine = io.StringIO()
+        real, sys.stdout = sys.stdout, mine
+        try:
+            text = errors.termcolor().errmsg("a typing error")
+            kept = sys.stdout is mine
+        finally:
+            sys.stdout = real
+        print(kept, text == "a typing error")
+        """
+    )
+    assert out.splitlines()[-1] == "True True"

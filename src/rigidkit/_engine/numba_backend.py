@@ -290,6 +290,8 @@ def drain(timeout=None) -> bool:
 
 def _work():
     global _AVAILABLE
+    # Before numba's first import: no colorama in its error messages (see _plain_errors).
+    os.environ.setdefault("NUMBA_DISABLE_ERROR_MESSAGE_HIGHLIGHTING", "1")
     try:
         import numba  # noqa: F401
     except Exception as exc:  # pragma: no cover - depends on the machine
@@ -297,6 +299,7 @@ def _work():
         error = RuntimeError(f"numba could not be imported: {exc}")
     else:
         error = None
+        _plain_errors()
     while True:
         job = _JOBS.get()
         try:
@@ -425,3 +428,32 @@ def precompile(kernels, dtypes=("float64", "float32"), verbose=False) -> int:
                 dt = time.perf_counter() - t0
                 print(f"{kern.fn.__module__}.{kern.name} {name}: {dt * 1e3:.0f} ms")
     return count
+
+
+class _PlainErrors:
+    """numba's colour scheme of error messages, without colours (its own NOP scheme)."""
+
+    def code(self, msg):
+        return msg
+
+    errmsg = filename = indicate = highlight = reset = code
+
+
+def _plain_errors():
+    """Keep numba's compiles on our thread off the process's ``sys.stdout``/``stderr``.
+
+    With colorama installed (evo, for one, brings it), numba formats the messages
+    of the typing errors it meets and recovers from during a compile inside
+    ``colorama.init()``/``deinit()``, which replace and restore ``sys.stdout`` and
+    ``sys.stderr``: on our background thread that undoes a caller's redirection
+    made meanwhile (``contextlib.redirect_stdout``, pytest's ``capsys``, a
+    doctest), whose output then goes to the old stream. The environment variable
+    set before numba's import turns the colours off; when numba was imported
+    earlier (by the user), its scheme is replaced here.
+    """
+    try:
+        from numba.core import errors
+    except Exception:  # pragma: no cover - numba's layout changed: nothing to undo
+        return
+    if type(errors._termcolor_inst).__name__ != "NOPColorScheme":
+        errors._termcolor_inst = _PlainErrors()
