@@ -23,6 +23,7 @@ import numpy as np
 
 from ..._validate import to_numpy
 from ...errors import ShapeError
+from ...objects.registry import stored
 from ...objects.transform import Transform
 from .trajectory import Trajectory
 
@@ -143,7 +144,7 @@ def _check(relation, ref, est):
 def _on_numpy(traj):
     """``traj`` with its poses as NumPy float64 (off torch's graph and device):
     the metrics are evaluation, computed in NumPy on the host."""
-    if isinstance(traj.poses.translation, np.ndarray):  # a view: no copy of the poses
+    if isinstance(stored(traj.poses), np.ndarray):  # the stored array, not a copy
         return traj
     pq = np.asarray(to_numpy(traj.poses.as_pq()), dtype=np.float64)
     return Trajectory._trusted(traj.stamps, Transform.from_pq(pq))
