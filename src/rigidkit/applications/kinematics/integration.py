@@ -112,6 +112,19 @@ def integrate(X0, rate, dt, method, fn, body=0):
     return spec.wrap(x)
 
 
+def integrate_from(X0, rate, dt, method, frame, fn, group, read):
+    """:func:`integrate` from an object of class ``group`` or from its matrices.
+
+    ``read`` validates matrices (``X0`` not a ``group``) for ``group.from_matrix``;
+    the trajectory comes back as ``X0`` came: objects, or their matrices.
+    """
+    body = body_flag(frame, fn)
+    as_object = isinstance(X0, group)
+    start = X0 if as_object else group.from_matrix(read(X0))
+    traj = integrate(start, rate, dt, method, fn, body)
+    return traj if as_object else traj.as_matrix()
+
+
 def _samples(rate, width, what, fn):
     shape = tuple(rate.shape) if hasattr(rate, "shape") else np.shape(rate)
     if len(shape) < 2 or shape[-1] != width:
@@ -165,12 +178,16 @@ def integrate_angular_velocity(R0, omega, dt, *, frame=None, method="exact"):
     >>> np.round(traj[-1].as_rotvec(), 12)
     array([0.        , 0.        , 1.57079633])
     """
-    fn = "integrate_angular_velocity"
-    body = body_flag(frame, fn)
-    as_object = isinstance(R0, Rotation)
-    X0 = R0 if as_object else Rotation.from_matrix(rotation_matrix(R0))
-    traj = integrate(X0, omega, dt, method, fn, body)
-    return traj if as_object else traj.as_matrix()
+    return integrate_from(
+        R0,
+        omega,
+        dt,
+        method,
+        frame,
+        "integrate_angular_velocity",
+        Rotation,
+        rotation_matrix,
+    )
 
 
 def integrate_twist(T0, twist, dt, *, frame=None, method="exact"):
@@ -207,12 +224,9 @@ def integrate_twist(T0, twist, dt, *, frame=None, method="exact"):
     >>> np.round(traj[-1].translation, 12)
     array([1., 1., 0.])
     """
-    fn = "integrate_twist"
-    body = body_flag(frame, fn)
-    as_object = isinstance(T0, Transform)
-    X0 = T0 if as_object else Transform.from_matrix(homogeneous_matrix(T0))
-    traj = integrate(X0, twist, dt, method, fn, body)
-    return traj if as_object else traj.as_matrix()
+    return integrate_from(
+        T0, twist, dt, method, frame, "integrate_twist", Transform, homogeneous_matrix
+    )
 
 
 def _like(x0, rate):

@@ -26,7 +26,7 @@ from ...kernels.kinematics import planar as _k
 from ...objects.rotation2d import Rotation2D
 from ...objects.transform2d import Transform2D
 from ._common import body_flag, vector
-from .integration import integrate
+from .integration import integrate_from
 from .samples import velocity_from_samples
 
 __all__ = [
@@ -299,11 +299,7 @@ def integrate_angular_velocity(R0, omega, dt, *, frame=None, method="exact"):
     ((101,), 1.570796326795)
     """
     fn = "planar.integrate_angular_velocity"
-    body = body_flag(frame, fn)
-    as_object = isinstance(R0, Rotation2D)
-    X0 = R0 if as_object else Rotation2D.from_matrix(_rotation(R0))
-    traj = integrate(X0, omega, dt, method, fn, body)
-    return traj if as_object else traj.as_matrix()
+    return integrate_from(R0, omega, dt, method, frame, fn, Rotation2D, _rotation)
 
 
 def integrate_twist(T0, twist, dt, *, frame=None, method="exact"):
@@ -341,11 +337,7 @@ def integrate_twist(T0, twist, dt, *, frame=None, method="exact"):
     array([0., 4.])
     """
     fn = "planar.integrate_twist"
-    body = body_flag(frame, fn)
-    as_object = isinstance(T0, Transform2D)
-    X0 = T0 if as_object else Transform2D.from_matrix(_transform(T0))
-    traj = integrate(X0, twist, dt, method, fn, body)
-    return traj if as_object else traj.as_matrix()
+    return integrate_from(T0, twist, dt, method, frame, fn, Transform2D, _transform)
 
 
 def angular_velocity_from_samples(rotations, times, *, frame=None):
