@@ -27,7 +27,7 @@ from ...objects.rotation2d import Rotation2D
 from ...objects.transform2d import Transform2D
 from ._common import body_flag, vector
 from .integration import integrate_from
-from .samples import velocity_from_samples
+from .samples import from_samples
 
 __all__ = [
     "angular_velocity",
@@ -372,10 +372,7 @@ def angular_velocity_from_samples(rotations, times, *, frame=None):
     array([2., 2., 2., 2.])
     """
     fn = "planar.angular_velocity_from_samples"
-    body = body_flag(frame, fn)
-    if not isinstance(rotations, Rotation2D):
-        rotations = Rotation2D.from_matrix(_rotation(rotations))
-    return velocity_from_samples(rotations, times, body, fn, "rotations")
+    return from_samples(rotations, times, frame, fn, Rotation2D, _rotation, "rotations")
 
 
 def twist_from_samples(transforms, times, *, frame=None):
@@ -389,13 +386,14 @@ def twist_from_samples(transforms, times, *, frame=None):
     transforms : Transform2D of shape (..., N), or array_like (..., N, 3, 3)
         Poses ``W_T_B`` at the sample times.
     times : array_like, shape (N,) or (..., N)
-        Strictly increasing.
+        Strictly increasing (non-uniform allowed).
     frame : {"world", "body"}
         World: ``hat(V) = T' T^-1``; body: ``T^-1 T'``.
 
     Returns
     -------
     array, shape (..., N, 3)
+        ``(vx, vy, omega)`` in the axes of ``frame``, per unit time.
 
     Examples
     --------
@@ -408,7 +406,4 @@ def twist_from_samples(transforms, times, *, frame=None):
     array([2., 0., 1.])
     """
     fn = "planar.twist_from_samples"
-    body = body_flag(frame, fn)
-    if not isinstance(transforms, Transform2D):
-        transforms = Transform2D.from_matrix(_transform(transforms))
-    return velocity_from_samples(transforms, times, body, fn, "transforms")
+    return from_samples(transforms, times, frame, fn, Transform2D, _transform, "transforms")

@@ -118,6 +118,17 @@ def velocity_from_samples(X, times, body, fn, what):
     return _combine(d, h, namespace_of(d), second, before_last)
 
 
+def from_samples(X, times, frame, fn, group, read, what):
+    """:func:`velocity_from_samples` of objects of class ``group`` or of matrices.
+
+    ``read`` validates matrices (``X`` not a ``group``) for ``group.from_matrix``.
+    """
+    body = body_flag(frame, fn)
+    if not isinstance(X, group):
+        X = group.from_matrix(read(X))
+    return velocity_from_samples(X, times, body, fn, what)
+
+
 def _adjoint_apply(X, tau):
     """``Ad_X tau`` for group elements (...) and tangents (..., dof)."""
     return (X.adjoint() @ tau[..., None])[..., 0]
@@ -152,10 +163,7 @@ def angular_velocity_from_samples(rotations, times, *, frame=None):
            [0., 0., 2.]])
     """
     fn = "angular_velocity_from_samples"
-    body = body_flag(frame, fn)
-    if not isinstance(rotations, Rotation):
-        rotations = Rotation.from_matrix(rotation_matrix(rotations))
-    return velocity_from_samples(rotations, times, body, fn, "rotations")
+    return from_samples(rotations, times, frame, fn, Rotation, rotation_matrix, "rotations")
 
 
 def twist_from_samples(transforms, times, *, frame=None):
@@ -185,7 +193,6 @@ def twist_from_samples(transforms, times, *, frame=None):
     array([1. , 0. , 0. , 0. , 0. , 0.5])
     """
     fn = "twist_from_samples"
-    body = body_flag(frame, fn)
-    if not isinstance(transforms, Transform):
-        transforms = Transform.from_matrix(homogeneous_matrix(transforms))
-    return velocity_from_samples(transforms, times, body, fn, "transforms")
+    return from_samples(
+        transforms, times, frame, fn, Transform, homogeneous_matrix, "transforms"
+    )
