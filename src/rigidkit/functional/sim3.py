@@ -183,11 +183,12 @@ def left_jacobian_inverse(xi):
     Parameters
     ----------
     xi : array_like, shape (..., 7)
-        Twists ``(v, omega, sigma)``, finite.
+        Twists ``(v, omega, sigma)``, finite, as for :func:`left_jacobian`.
 
     Returns
     -------
     ndarray, shape (..., 7, 7)
+        ``J_l^-1``, acting on twists ``(v, omega, sigma)``.
 
     See Also
     --------
