@@ -99,6 +99,7 @@ def exp_coords_from_pose(pose):
     Returns
     -------
     ndarray, shape (..., 6)
+        ``(w, v)``, rotation first.
 
     See Also
     --------

@@ -37,17 +37,12 @@ from ..errors import NotARigidTransformError, NotARotationError, OutOfRangeError
 from ..kernels import se3 as _k
 from . import _lie
 from . import conversions as _conv
+from . import pose_formats as _formats
 
-# The other layouts of a pose live in pose_formats; rk.se3 offers them too.
-from .pose_formats import (
-    _pose,
-    dual_quat_from_pose,
-    exp_coords_from_pose,
-    pose_from_dual_quat,
-    pose_from_exp_coords,
-    pose_from_pq,
-    pq_from_pose,
-)
+# The other layouts of a pose live in pose_formats; rk.se3 offers them too (its
+# __all__, taken whole below).
+from .pose_formats import *  # noqa: F403
+from .pose_formats import _pose
 
 __all__ = [
     *_lie.VOCABULARY,
@@ -55,12 +50,7 @@ __all__ = [
     "matrix_from_pose",
     "pose_from_twist",
     "twist_from_pose",
-    "pose_from_exp_coords",
-    "exp_coords_from_pose",
-    "pose_from_dual_quat",
-    "dual_quat_from_pose",
-    "pose_from_pq",
-    "pq_from_pose",
+    *_formats.__all__,
     "pose_distance",
     "pose_distance_unchecked",
 ]
@@ -131,6 +121,7 @@ def log(M, *, atol=None):
     Returns
     -------
     ndarray, shape (..., 6)
+        Twists ``(v, w)``, translation first.
 
     See Also
     --------
