@@ -24,14 +24,11 @@ The group acts on points through its pose part, ``x -> R x + p`` (the matrix on
 """
 
 from .._engine import helper, kernel
-from .coefficients import cot_defect2, sin_defect3
 from .matrix import matrix_from_quat
-from .quaternion import quat_angle, quat_apply, quat_compose
-from .se3 import se3_q_entries
+from .quaternion import quat_apply, quat_compose
+from .se3 import se3_exp_pieces, se3_log_pieces, se3_q_entries
 from .so3 import (
     eye_hat_hat2_apply,
-    half_angle_from_rotvec,
-    rotvec_entries_from_quat,
     so3_left_jacobian_entries,
     so3_left_jacobian_inverse_entries,
 )
@@ -57,13 +54,10 @@ def se23_block_upper(j, a, b):
 @helper
 def se23_exp_entries(ax, ay, az, bx, by, bz, wx, wy, wz):
     """``(q, J_l(w) a, J_l(w) b)`` of the tangent ``(a, b, w)``, as 10 scalars."""
-    qw, s, theta = half_angle_from_rotvec(wx, wy, wz)
-    # versinc2(theta) is 2 s^2 with s = sin(t/2)/t at hand (as pose_from_twist).
-    k1 = 2.0 * s * s
-    k2 = sin_defect3(theta)
+    qw, qx, qy, qz, k1, k2 = se3_exp_pieces(wx, wy, wz)
     vx, vy, vz = eye_hat_hat2_apply(wx, wy, wz, k1, k2, ax, ay, az)
     px, py, pz = eye_hat_hat2_apply(wx, wy, wz, k1, k2, bx, by, bz)
-    return (qw, s * wx, s * wy, s * wz, vx, vy, vz, px, py, pz)
+    return (qw, qx, qy, qz, vx, vy, vz, px, py, pz)
 
 
 # -- extended poses ---------------------------------------------------------------------
@@ -148,8 +142,7 @@ def tangent_from_extpose(w, x, y, z, vx, vy, vz, px, py, pz):
     ``w`` is the rotation vector of ``q`` (``atan2``-based); ``J_l^-1 = I - hat(w)/2 +
     cot_defect2(t) hat(w)^2`` is finite up to ``t = pi`` (as :func:`.se3.twist_from_pose`).
     """
-    rx, ry, rz = rotvec_entries_from_quat(w, x, y, z)
-    c = cot_defect2(quat_angle(w, x, y, z))
+    rx, ry, rz, c = se3_log_pieces(w, x, y, z)
     ax, ay, az = eye_hat_hat2_apply(rx, ry, rz, -0.5, c, vx, vy, vz)
     bx, by, bz = eye_hat_hat2_apply(rx, ry, rz, -0.5, c, px, py, pz)
     return (ax, ay, az, bx, by, bz, rx, ry, rz)

@@ -118,6 +118,29 @@ def se3_block_upper(j, q):
 # -- poses -----------------------------------------------------------------------------
 
 
+@helper
+def se3_exp_pieces(wx, wy, wz):
+    """Quaternion of ``exp(hat(w))`` and the coefficients ``(k1, k2)`` of
+    ``J_l(w) = I + k1 hat(w) + k2 hat(w)^2``, as 6 scalars ``(qw, qx, qy, qz, k1, k2)``.
+
+    ``k1 = (1 - cos t)/t^2`` is ``2 s^2`` with ``s = sin(t/2)/t`` already at hand for
+    the quaternion (one sine fewer); ``k2 = (t - sin t)/t^3``; ``t = |w|``.
+    """
+    qw, s, theta = half_angle_from_rotvec(wx, wy, wz)
+    return (qw, s * wx, s * wy, s * wz, 2.0 * s * s, sin_defect3(theta))
+
+
+@helper
+def se3_log_pieces(w, x, y, z):
+    """Rotation vector ``r`` of ``q`` (``|r|`` in [0, pi]) and the coefficient ``c`` of
+    ``J_l(r)^-1 = I - hat(r)/2 + c hat(r)^2``, as 4 scalars ``(rx, ry, rz, c)``.
+
+    ``c = cot_defect2(t)``, ``t = |r|``, is finite up to ``t = pi``.
+    """
+    rx, ry, rz = rotvec_entries_from_quat(w, x, y, z)
+    return (rx, ry, rz, cot_defect2(quat_angle(w, x, y, z)))
+
+
 @kernel(inputs=[(4,), (3,)], outputs=[(7,)])
 def pose_from_quat_translation(w, x, y, z, tx, ty, tz):
     """Pack a unit quaternion and a translation into a pose (broadcasting both)."""
@@ -209,10 +232,9 @@ def pose_from_twist(vx, vy, vz, wx, wy, wz):
     Sec. 2.3, for a unit axis and an angle) written for ``w = theta * axis``:
     ``(I - R)(w x v)/t^2 + w w^T v / t^2``.
     """
-    qw, s, theta = half_angle_from_rotvec(wx, wy, wz)
-    # versinc2(theta) is 2 s^2, s = sin(t/2)/t, already at hand: one sine fewer.
-    tx, ty, tz = eye_hat_hat2_apply(wx, wy, wz, 2.0 * s * s, sin_defect3(theta), vx, vy, vz)
-    return (qw, s * wx, s * wy, s * wz, tx, ty, tz)
+    qw, qx, qy, qz, k1, k2 = se3_exp_pieces(wx, wy, wz)
+    tx, ty, tz = eye_hat_hat2_apply(wx, wy, wz, k1, k2, vx, vy, vz)
+    return (qw, qx, qy, qz, tx, ty, tz)
 
 
 @kernel(inputs=[(7,)], outputs=[(6,)])
@@ -223,9 +245,8 @@ def twist_from_pose(w, x, y, z, tx, ty, tz):
     ``atan2``, no cancellation near 0 or pi) and ``v = J_l(w)^-1 t``, where
     ``J_l^-1 = I - hat(w)/2 + cot_defect2(t) hat(w)^2`` is finite up to ``t = pi``.
     """
-    rx, ry, rz = rotvec_entries_from_quat(w, x, y, z)
-    theta = quat_angle(w, x, y, z)
-    vx, vy, vz = eye_hat_hat2_apply(rx, ry, rz, -0.5, cot_defect2(theta), tx, ty, tz)
+    rx, ry, rz, c = se3_log_pieces(w, x, y, z)
+    vx, vy, vz = eye_hat_hat2_apply(rx, ry, rz, -0.5, c, tx, ty, tz)
     return (vx, vy, vz, rx, ry, rz)
 
 
