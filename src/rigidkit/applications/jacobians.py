@@ -422,7 +422,9 @@ def between(X, Y, *, side="right"):
     Returns
     -------
     Z : LieGroup
+        ``X^-1 Y``, in the batch shape of ``X`` and ``Y`` broadcast.
     J_X, J_Y : ndarray, shape Z.shape + (dof, dof)
+        ``dZ/dX`` and ``dZ/dY`` on ``side``.
 
     See Also
     --------
@@ -430,11 +432,13 @@ def between(X, Y, *, side="right"):
 
     Examples
     --------
+    An element seen from itself is the identity: ``dZ/dX = -I``, ``dZ/dY = I``.
+
     >>> import numpy as np
     >>> import rigidkit as rk
-    >>> A_T_B = rk.Transform.exp([1.0, 0.0, 0.0, 0.0, 0.0, 0.3])
-    >>> B_T_C, J_AB, J_AC = rk.jacobians.between(A_T_B, A_T_B)
-    >>> bool(np.allclose(J_AB, -np.eye(6))), bool(np.allclose(J_AC, np.eye(6)))
+    >>> A_R_B = rk.Rotation.from_rotvec([0.1, 0.2, 0.3])
+    >>> B_R_B, J_AB, J_AC = rk.jacobians.between(A_R_B, A_R_B)
+    >>> bool(np.allclose(J_AB, -np.eye(3))), bool(np.allclose(J_AC, np.eye(3)))
     (True, True)
     """
     _same_kind(X, Y, "between")
