@@ -108,12 +108,8 @@ def davenport_from_quat(
     sin_lam = (px + sg * fx) * kx + (py + sg * fy) * ky + (pz + sg * fz) * kz
     lam = atan2(-((-sin_lam) + 0.0), cos_lam)
     s = where(lam > 0.0, -1.0, 1.0)
-    bx = s * bx
-    by = s * by
-    bz = s * bz
-    kx = s * kx
-    ky = s * ky
-    kz = s * kz
+    bx, by, bz = s * bx, s * by, s * bz
+    kx, ky, kz = s * kx, s * ky, s * kz
     lam = s * lam  # <= 0
     h = -0.5 * lam
     sh = sin(h)
