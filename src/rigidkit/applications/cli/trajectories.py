@@ -94,33 +94,40 @@ def _add_common(p, relation=True):
     )
 
 
+def _command(commands, name, help, description, example, run, relation=True):
+    """A subcommand ``name`` with the options every trajectory command takes."""
+    p = commands.add_parser(
+        name,
+        help=help,
+        description=description,
+        epilog=_COMMON_EPILOG + f"\nexample:\n  rigidkit {name} {example}\n",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        allow_abbrev=False,
+    )
+    _add_common(p, relation=relation)
+    p.set_defaults(func=run)
+    return p
+
+
 def add_trajectory_commands(commands) -> None:
     """Add ``ape``, ``rpe`` and ``kitti`` to the subparsers ``commands``."""
-    fmt = argparse.RawDescriptionHelpFormatter
-    ape = commands.add_parser(
+    _command(
+        commands,
         "ape",
-        help="absolute pose error of an estimated trajectory",
-        description="Absolute pose error: E_i = est_i^-1 ref_i for each pose pair.",
-        epilog=_COMMON_EPILOG
-        + "\nexample:\n  rigidkit ape groundtruth.txt estimate.txt --align sim3\n",
-        formatter_class=fmt,
-        allow_abbrev=False,
+        "absolute pose error of an estimated trajectory",
+        "Absolute pose error: E_i = est_i^-1 ref_i for each pose pair.",
+        "groundtruth.txt estimate.txt --align sim3",
+        run_ape,
     )
-    _add_common(ape)
-    ape.set_defaults(func=run_ape)
-    rpe = commands.add_parser(
+    rpe = _command(
+        commands,
         "rpe",
-        help="relative pose error (drift) of an estimated trajectory",
-        description=(
-            "Relative pose error: E_ij = (ref_i^-1 ref_j)^-1 (est_i^-1 est_j) over pose\n"
-            "pairs DELTA apart (in frames, metres or degrees of rotation)."
-        ),
-        epilog=_COMMON_EPILOG
-        + "\nexample:\n  rigidkit rpe gt.txt est.txt --delta 1 --unit meters --all-pairs\n",
-        formatter_class=fmt,
-        allow_abbrev=False,
+        "relative pose error (drift) of an estimated trajectory",
+        "Relative pose error: E_ij = (ref_i^-1 ref_j)^-1 (est_i^-1 est_j) over pose\n"
+        "pairs DELTA apart (in frames, metres or degrees of rotation).",
+        "gt.txt est.txt --delta 1 --unit meters --all-pairs",
+        run_rpe,
     )
-    _add_common(rpe)
     rpe.add_argument(
         "--delta", type=float, default=1.0, help="pair spacing in --unit (default 1)"
     )
@@ -147,23 +154,19 @@ def add_trajectory_commands(commands) -> None:
         default="estimate",
         help="the trajectory whose path chooses the pairs (default estimate)",
     )
-    rpe.set_defaults(func=run_rpe)
-    kitti = commands.add_parser(
+    kitti = _command(
+        commands,
         "kitti",
-        help="KITTI odometry errors (%% and deg/100 m over 100-800 m segments)",
-        description=(
-            "The KITTI odometry benchmark's errors: drift over path segments of\n"
-            "100, 200, ..., 800 m starting every 10th frame (Geiger et al. 2012)."
-        ),
-        epilog=_COMMON_EPILOG + "\nexample:\n  rigidkit kitti 00.txt 00_orb.txt\n",
-        formatter_class=fmt,
-        allow_abbrev=False,
+        "KITTI odometry errors (%% and deg/100 m over 100-800 m segments)",
+        "The KITTI odometry benchmark's errors: drift over path segments of\n"
+        "100, 200, ..., 800 m starting every 10th frame (Geiger et al. 2012).",
+        "00.txt 00_orb.txt",
+        run_kitti,
+        relation=False,
     )
-    _add_common(kitti, relation=False)
     kitti.add_argument(
         "--step", type=_positive_int, default=10, help="spacing of first frames (10)"
     )
-    kitti.set_defaults(func=run_kitti)
 
 
 # -- running ---------------------------------------------------------------------------

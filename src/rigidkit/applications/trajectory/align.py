@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...errors import DegenerateInputError, ShapeError
+from ...errors import DegenerateInputError
 from ...objects.rotation import Rotation
 from ...objects.similarity import Similarity
 from ...objects.transform import Transform
 from ..alignment import align_points
-from .trajectory import Trajectory
+from .trajectory import check_pair
 
 __all__ = ["METHODS", "align"]
 
@@ -93,14 +93,7 @@ def align(est, ref, method="se3", first=None):
     """
     if method not in METHODS:
         raise ValueError(f"method must be one of {', '.join(METHODS)}; got {method!r}")
-    for name, traj in (("est", est), ("ref", ref)):
-        if not isinstance(traj, Trajectory):
-            raise TypeError(f"{name} must be a Trajectory, got {type(traj).__name__}")
-    if len(est) != len(ref):
-        raise ShapeError(
-            f"est has {len(est)} poses and ref {len(ref)}: align corresponding poses "
-            "(rigidkit.trajectory.associate pairs them)"
-        )
+    check_pair(("est", est), ("ref", ref), "align")
     lead = np.broadcast_shapes(est.shape[:-1], ref.shape[:-1])
     n = len(est) if first is None else int(first)
     if not 1 <= n <= len(est):

@@ -25,7 +25,7 @@ from ..._validate import to_numpy
 from ...errors import ShapeError
 from ...objects.registry import stored
 from ...objects.transform import Transform
-from .trajectory import Trajectory
+from .trajectory import Trajectory, check_pair
 
 __all__ = ["RELATIONS", "UNITS", "MetricResult", "ape", "pair_indices", "rpe", "statistics"]
 
@@ -131,14 +131,7 @@ def _check(relation, ref, est):
         raise ValueError(
             f"relation must be one of {', '.join(RELATIONS)}; got {relation!r}"
         )
-    for name, traj in (("ref", ref), ("est", est)):
-        if not isinstance(traj, Trajectory):
-            raise TypeError(f"{name} must be a Trajectory, got {type(traj).__name__}")
-    if len(ref) != len(est):
-        raise ShapeError(
-            f"ref has {len(ref)} poses and est {len(est)}: compare corresponding poses "
-            "(rigidkit.trajectory.associate pairs them)"
-        )
+    check_pair(("ref", ref), ("est", est), "compare")
 
 
 def _on_numpy(traj):

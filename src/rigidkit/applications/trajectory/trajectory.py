@@ -12,7 +12,7 @@ from ..interpolation import Slerp
 from ..kinematics import twist_from_samples
 from ..splines import BSplineSE3
 
-__all__ = ["Trajectory", "check_stamps"]
+__all__ = ["Trajectory", "check_stamps", "check_pair"]
 
 
 def _moveaxis(x, source: int, destination: int):
@@ -320,3 +320,20 @@ class Trajectory:
         if not isinstance(self._poses.translation, np.ndarray):
             t = np.array(t)  # writable: torch warns on a read-only NumPy array
         return twist_from_samples(self._poses, t, frame=frame)
+
+
+def check_pair(first, second, purpose: str) -> None:
+    """Two ``(name, trajectory)`` pairs: both a :class:`Trajectory`, of one length.
+
+    ``purpose`` completes the length error ("align", "compare"): corresponding
+    poses are what :func:`rigidkit.trajectory.associate` returns.
+    """
+    for name, traj in (first, second):
+        if not isinstance(traj, Trajectory):
+            raise TypeError(f"{name} must be a Trajectory, got {type(traj).__name__}")
+    (n1, t1), (n2, t2) = first, second
+    if len(t1) != len(t2):
+        raise ShapeError(
+            f"{n1} has {len(t1)} poses and {n2} {len(t2)}: {purpose} corresponding "
+            "poses (rigidkit.trajectory.associate pairs them)"
+        )
