@@ -108,7 +108,7 @@ class Libs:
         self.pr, _ = _try_import("pytransform3d.rotations")
         if err:
             self.notes["pytransform3d"] = f"skipped, not installed ({err})"
-        self.euler, err = _try_import("rigidkit.euler")
+        self.euler, err = _try_import("rigidkit.functional.euler")
         if err:
             self.notes["rigidkit.euler"] = (
                 f"rigidkit from_euler/as_euler skipped: rigidkit.euler missing ({err})"
