@@ -19,6 +19,7 @@ alone when it is missing; every other test of the file still runs. Three spellin
 from __future__ import annotations
 
 import importlib
+import importlib.util
 import os
 
 import numpy as np
@@ -26,6 +27,14 @@ import pytest
 from hypothesis import HealthCheck, settings
 
 from rigidkit.objects import registry
+
+# torch's setup (bindings, adapter, pytree nodes) once per test process, where torch
+# is installed: as the doctest collection of rigidkit._engine.torch_setup did before
+# it was left out of collection (pyproject.toml: it imports torch at its top level).
+# The setup done lazily, at the first tensor, is tested in fresh processes
+# (tests/test_engine.py).
+if importlib.util.find_spec("torch") is not None:
+    import rigidkit._engine.torch_setup  # noqa: F401
 
 settings.register_profile(
     "default",
