@@ -26,7 +26,6 @@ or goes backwards).
 from __future__ import annotations
 
 import os
-import re
 import warnings
 
 import numpy as np
@@ -34,6 +33,7 @@ import numpy as np
 from ...errors import TimestampError, TrajectoryFileError
 from ...objects.transform import Transform
 from ..trajectory.trajectory import Trajectory, check_stamps
+from ._csv_header import column_of, csv_delimiter
 from ._parse import parse_table
 
 __all__ = ["FORMATS", "KITTI_ATOL", "read_trajectory", "write_trajectory"]
@@ -246,40 +246,6 @@ def _read_euroc(src):
     return Trajectory._trusted(stamps, poses)
 
 
-_UNIT = re.compile(r"\[[^\]]*\]|\([^)]*\)")
-_TIME = re.compile(
-    r"^(?:#\s*)?(?:t|time|times|timestamp|stamp|sec|secs|seconds)(?:[_.]?(ns|nsec|s))?$"
-)
-_POS = re.compile(r"^(?:t|p|pos|position|translation|trans)?[_.]?(?:[a-z]+[_.])*?([xyz])$")
-_QUAT = re.compile(
-    r"^(?:q|quat|quaternion|orientation|rot|rotation)[_.]?(?:[a-z]+[_.])*?([wxyz])$"
-)
-
-
-def _column(name: str):
-    """``("t", ns)``, ``("p", axis)``, ``("q", comp)`` or None for a header name."""
-    raw = name.strip().strip('"').strip().lower()
-    ns = "[ns]" in raw.replace(" ", "")
-    key = _UNIT.sub("", raw).strip().lstrip("#").strip().replace(" ", "_")
-    m = _TIME.match(key)
-    if m:
-        return ("t", ns or m.group(1) in ("ns", "nsec"))
-    m = _QUAT.match(key)
-    if m:
-        return ("q", m.group(1))
-    m = _POS.match(key)
-    if m and not key.startswith(("q", "rot", "orientation")):
-        return ("p", m.group(1))
-    return None
-
-
-def _csv_delimiter(line: str):
-    for d in (",", ";", "\t"):
-        if d in line:
-            return d
-    return None
-
-
 def _read_csv(src):
     first = next(
         (
@@ -292,7 +258,7 @@ def _read_csv(src):
     if first is None:
         _fail(src.path, None, "is empty; a CSV trajectory needs a header line")
     n, header = first
-    delimiter = _csv_delimiter(header)
+    delimiter = csv_delimiter(header)
     names = _split(header.lstrip("#") if header.startswith("#") else header, delimiter)
     if any(_is_number(x) for x in names):
         _fail(
@@ -303,7 +269,7 @@ def _read_csv(src):
         )
     found = {}
     for k, name in enumerate(names):
-        col = _column(name)
+        col = column_of(name)
         if col is None:
             continue
         key = "t" if col[0] == "t" else col
@@ -361,7 +327,7 @@ def _detect(src) -> str:
             _fail(src.path, None, "holds no pose (only comments)")
         n, line = data
     if "," in line or ";" in line or "\t" in line.strip():
-        fields = _split(line, _csv_delimiter(line))
+        fields = _split(line, csv_delimiter(line))
         if not all(_is_number(f) for f in fields):
             return "csv"
         if len(fields) >= 8 and abs(float(fields[0])) > 1e15:
