@@ -168,15 +168,3 @@ def test_jax_jit_and_grad(jax, jnp, rng):
     # log(exp(x)) = x: its gradient of the sum is a row of ones.
     g = jax.grad(lambda x: jnp.sum(rk.ExtendedPose.exp(x).log()))(jnp.asarray(xi[0]))
     np.testing.assert_allclose(np.asarray(g), np.ones(9), atol=1e-10)
-
-
-@pytest.fixture(autouse=True, scope="module")
-def _settle_compiles_after():
-    """The numba loops these tests ask for are compiled on rigidkit's background
-    thread; wait for them at the end of the module (see conftest.settle_compiles):
-    doctests run while such compiles were in flight lost their output ("Got
-    nothing"), seen after this module."""
-    yield
-    from conftest import settle_compiles
-
-    settle_compiles()

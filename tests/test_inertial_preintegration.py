@@ -371,15 +371,3 @@ def test_the_rate_of_cos_defect4_against_mpmath():
 
     want = np.array([ref(v) for v in x])
     np.testing.assert_allclose(got, want, rtol=8 * np.finfo(float).eps, atol=0)
-
-
-@pytest.fixture(autouse=True, scope="module")
-def _settle_compiles_after():
-    """The numba loops these tests ask for are compiled on rigidkit's background
-    thread; wait for them at the end of the module (see conftest.settle_compiles):
-    doctests run while such compiles were in flight lost their output ("Got
-    nothing"), seen after this module."""
-    yield
-    from conftest import settle_compiles
-
-    settle_compiles()

@@ -113,15 +113,3 @@ def test_preintegrated_covariance_matches_simulated_scatter(spline):
     sd = np.sqrt(np.diag(pim.covariance))
     C = np.cov(err.T) / np.outer(sd, sd)
     np.testing.assert_allclose(C, pim.covariance / np.outer(sd, sd), rtol=0, atol=0.1)
-
-
-@pytest.fixture(autouse=True, scope="module")
-def _settle_compiles_after():
-    """The numba loops these tests ask for are compiled on rigidkit's background
-    thread; wait for them at the end of the module (see conftest.settle_compiles):
-    doctests run while such compiles were in flight lost their output ("Got
-    nothing"), seen after this module."""
-    yield
-    from conftest import settle_compiles
-
-    settle_compiles()

@@ -233,15 +233,3 @@ def test_jax_vmap_and_grad(jax, jnp, rng):
     h, tk = 0.01, 0.01 * np.arange(16)
     weights = h * (16 * h - tk) - h * h / 2  # d p_N / d f_k = R0 (that weight)
     np.testing.assert_allclose(np.asarray(g), np.outer(weights, R0[0]), rtol=0, atol=1e-13)
-
-
-@pytest.fixture(autouse=True, scope="module")
-def _settle_compiles_after():
-    """The numba loops these tests ask for are compiled on rigidkit's background
-    thread; wait for them at the end of the module (see conftest.settle_compiles):
-    doctests run while such compiles were in flight lost their output ("Got
-    nothing"), seen after this module."""
-    yield
-    from conftest import settle_compiles
-
-    settle_compiles()
