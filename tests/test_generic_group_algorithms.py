@@ -88,3 +88,42 @@ def test_slerp_follows_the_matrix_geodesic(G):
 def test_slerp_refuses_two_kinds():
     with pytest.raises(TypeError, match="one Lie group"):
         rk.slerp(rk.Rotation2D.identity(), rk.Transform2D.identity(), 0.5)
+
+
+@groups
+def test_slerp_on_torch_and_under_jax_jit(G, torch, jax, jnp):
+    a, b = G.random(3, rng=1), G.random(3, rng=2)
+    t = np.array([0.2, 0.5, 0.9])
+    want = rk.slerp(a, b, t).as_matrix()
+    ends = [G.exp(torch.tensor(x.log())) for x in (a, b)]
+    got = rk.slerp(*ends, torch.tensor(t)).as_matrix()
+    assert isinstance(got, torch.Tensor)
+    np.testing.assert_allclose(got.numpy(), want, atol=1e-12)
+    f = jax.jit(lambda x, y, s: rk.slerp(G.exp(x), G.exp(y), s).as_matrix())
+    got = f(jnp.asarray(a.log()), jnp.asarray(b.log()), jnp.asarray(t))
+    np.testing.assert_allclose(np.asarray(got), want, atol=1e-12)
+
+
+@groups
+@pytest.mark.parametrize("gap", [0.0, 1e-8])
+def test_slerp_gradient_at_coincident_ends(G, gap, torch):
+    """d/ds of log(slerp(I, exp(gap e0 + s), 0.3)) by autograd and by central
+    differences, where the geodesic's log is at (or next to) its zero."""
+    t = torch.tensor(0.3, dtype=torch.float64)
+    y = torch.zeros(G.dof, dtype=torch.float64)
+    y[0] = gap
+
+    def f(s):
+        return rk.slerp(G.identity(), G.exp(y + s), t).log().sum()
+
+    s = torch.zeros(G.dof, dtype=torch.float64, requires_grad=True)
+    (g,) = torch.autograd.grad(f(s), s)
+    e = torch.eye(G.dof, dtype=torch.float64) * 1e-6
+    fd = [(f(e[i]) - f(-e[i])).item() / 2e-6 for i in range(G.dof)]
+    np.testing.assert_allclose(g.numpy(), fd, atol=1e-7)
+
+
+@groups
+def test_mean_keeps_float32(G):
+    X = G.exp(_concentrated(G, 5, np.random.default_rng(2)).log().astype(np.float32))
+    assert X.mean()._data.dtype == np.float32
