@@ -236,6 +236,32 @@ def test_rotation_spline_matches_converged_scipy(keyframes):
     assert np.all(quat_angle(spline(times).as_quat(), keys.as_quat()) < 1e-14)
 
 
+def test_rotation_spline_extrapolates_as_scipy(keyframes):
+    """``extrapolate=True`` continues the end cubics exactly as scipy's spline does."""
+    times, keys = keyframes
+    spline = rk.RotationSpline(times, keys, extrapolate=True)
+    ref = converged_scipy_spline(times, keys)
+    span = times[-1] - times[0]
+    t = np.concatenate(
+        [np.linspace(times[0] - 0.3 * span, times[0], 40, endpoint=False),
+         np.linspace(times[-1], times[-1] + 0.3 * span, 40)[1:]]
+    )  # fmt: skip
+    assert np.all(
+        quat_angle(spline(t).as_quat(), ref(t).as_quat(scalar_first=True)) < 1e-12
+    )
+    assert np.allclose(spline(t, 1, frame="body"), ref(t, 1), atol=1e-11)
+    assert np.allclose(spline(t, 2, frame="body"), ref(t, 2), atol=1e-11)
+    world = spline(t).apply(spline(t, 1, frame="body"))
+    assert np.allclose(spline(t, 1, frame="world"), world, atol=1e-12)
+    inside = np.linspace(times[0], times[-1], 50)  # the option changes nothing inside
+    assert np.array_equal(
+        spline(inside).as_quat(), rk.RotationSpline(times, keys)(inside).as_quat()
+    )
+    # the default keeps rejecting times outside the range
+    with pytest.raises(rk.OutOfRangeError):
+        rk.RotationSpline(times, keys)(times[-1] + 0.1)
+
+
 def test_rotation_spline_is_exactly_c2_where_scipys_is_not(keyframes):
     """The one-sided limits of the angular acceleration agree at every interior knot.
 

@@ -137,9 +137,14 @@ def keyframe_times(times, count, what="keyframes"):
     return t
 
 
-def query_times(times, lo, hi):
-    """Query ``times`` as a float64 NumPy array (any shape), checked within [lo, hi]."""
+def query_times(times, lo, hi, *, extrapolate=False):
+    """Query ``times`` as a float64 NumPy array (any shape), checked within [lo, hi].
+
+    ``extrapolate=True`` accepts any finite time (no range check).
+    """
     q = np.asarray(to_numpy(finite_array(times, (), "times")), dtype=np.float64)
+    if extrapolate:
+        return q
     out = (q < lo) | (q > hi)
     if out.any():
         idx = tuple(int(i) for i in np.argwhere(out)[0])

@@ -49,6 +49,7 @@ class _Spline:
 
     kind = Rotation
     t_min = t_max = 0.0
+    extrapolate = False
 
     def __call__(self, times, order=0, *, frame=None):
         """Rotations (order 0), velocities (1) or accelerations (2) at ``times``.
@@ -56,7 +57,8 @@ class _Spline:
         Parameters
         ----------
         times : array_like, shape (...)
-            Within ``[t_min, t_max]``, else :class:`~rigidkit.OutOfRangeError`.
+            Within ``[t_min, t_max]``, else :class:`~rigidkit.OutOfRangeError`
+            (any finite time for a spline made with ``extrapolate=True``).
         order : {0, 1, 2}
         frame : {"body", "world"}
             Required for orders 1 and 2 (:class:`~rigidkit.FrameKeywordError` otherwise).
@@ -67,7 +69,7 @@ class _Spline:
         ``times.shape + extra + (3,)`` (SO(3)) or ``(6,)`` (SE(3) twists ``(v, w)``).
         """
         _check_order(order, frame)
-        q = query_times(times, self.t_min, self.t_max)
+        q = query_times(times, self.t_min, self.t_max, extrapolate=self.extrapolate)
         flat = q.reshape(-1)
         wrap = registry.spec(self.kind).wrap
         if order == 0:
@@ -99,6 +101,11 @@ class RotationSpline(_Spline):
     rotations : Rotation, shape (n, ...)
         Keyframes, time axis first; further batch axes give several splines on
         the same times.
+    extrapolate : bool
+        Outside ``[times[0], times[-1]]``: ``False`` (default) raises
+        :class:`~rigidkit.OutOfRangeError`; ``True`` continues the first and last
+        cubic segments, as scipy's ``RotationSpline`` does (its rates and
+        accelerations too).
 
     Examples
     --------
@@ -111,9 +118,12 @@ class RotationSpline(_Spline):
     True
     >>> spline(5.0, 1, frame="body").shape                    # rad per time unit
     (3,)
+    >>> ahead = rk.RotationSpline([0.0, 10.0, 20.0], keys, extrapolate=True)
+    >>> ahead([-5.0, 25.0]).shape                             # the end cubics continued
+    (2,)
     """
 
-    def __init__(self, times, rotations):
+    def __init__(self, times, rotations, *, extrapolate=False):
         keyframe_kind(rotations, 2, "rotations")
         if not isinstance(rotations, Rotation):
             raise TypeError(
@@ -121,6 +131,7 @@ class RotationSpline(_Spline):
             )
         self.times = keyframe_times(times, len(rotations), "rotations")
         self.rotations = rotations
+        self.extrapolate = bool(extrapolate)
         self.t_min, self.t_max = float(self.times[0]), float(self.times[-1])
         self._coeffs, self.iterations = _fs.rotation_spline_coefficients(
             self.times, stored(rotations)
