@@ -79,53 +79,70 @@ def _loop(buf, ncols, exact, delim, pow10, out, lines, slow):
             if col > 0 and not after_delim:  # two fields without a delimiter
                 return BAD_TOKEN, row, line, col + 1, nslow
             after_delim = False
-        # A token: [+-]digits[.digits][(e|E)[+-]digits], at most 18 digits kept.
+        # A token: [+-]digits[.digits][(e|E)[+-]digits].
         start = pos
         neg = False
         if c == 43 or c == 45:
             neg = c == 45
             pos += 1
+        # The fast scan: every digit into mant (exact while there are at most
+        # 18 of them: mant < 10^18 < 2^63); more digits are scanned again below.
+        digits = pos
         mant = 0
-        ndig = 0
-        drop = 0
-        frac = 0
-        seen = 0
-        inexact = False
         while pos < n:
             d = np.int64(buf[pos]) - 48
             if d < 0 or d > 9:
                 break
-            seen += 1
-            if ndig < 18:
-                if mant > 0 or d != 0:
-                    ndig += 1
-                mant = mant * 10 + d
-            else:
-                drop += 1
-                inexact = True
+            mant = mant * 10 + d
             pos += 1
-        tz = 0  # trailing zeros of the fraction kept in mant ("0.500000000")
+        seen = pos - digits
+        frac = 0
         if pos < n and buf[pos] == 46:
             pos += 1
+            fstart = pos
             while pos < n:
                 d = np.int64(buf[pos]) - 48
                 if d < 0 or d > 9:
                     break
-                seen += 1
+                mant = mant * 10 + d
+                pos += 1
+            frac = pos - fstart
+            seen += frac
+        drop = 0
+        inexact = False
+        if seen > 18:
+            # The careful scan: the first 18 significant digits into mant, the
+            # rest counted (the integer part's) or checked to be zeros.
+            pos = digits
+            mant = 0
+            ndig = 0
+            while pos < n:
+                d = np.int64(buf[pos]) - 48
+                if d < 0 or d > 9:
+                    break
                 if ndig < 18:
                     if mant > 0 or d != 0:
                         ndig += 1
                     mant = mant * 10 + d
-                    frac += 1
-                    tz = tz + 1 if d == 0 else 0
-                elif d != 0:
+                else:
+                    drop += 1
                     inexact = True
                 pos += 1
-            if mant >= 9007199254740992:
-                while tz > 0:  # exact: they are zeros
-                    mant //= 10
-                    frac -= 1
-                    tz -= 1
+            frac = 0
+            if pos < n and buf[pos] == 46:
+                pos += 1
+                while pos < n:
+                    d = np.int64(buf[pos]) - 48
+                    if d < 0 or d > 9:
+                        break
+                    if ndig < 18:
+                        if mant > 0 or d != 0:
+                            ndig += 1
+                        mant = mant * 10 + d
+                        frac += 1
+                    elif d != 0:
+                        inexact = True
+                    pos += 1
         exp = 0
         good = seen > 0
         if good and pos < n and (buf[pos] == 101 or buf[pos] == 69):
@@ -159,6 +176,10 @@ def _loop(buf, ncols, exact, delim, pow10, out, lines, slow):
                     pos += 1
         if col < ncols:
             e10 = exp - frac + drop
+            # Trailing zeros of the mantissa move into the exponent (exactly).
+            while mant >= 9007199254740992 and mant % 10 == 0:
+                mant //= 10
+                e10 += 1
             if good and not inexact and mant < 9007199254740992 and -22 <= e10 <= 22:
                 v = float(mant)
                 if e10 >= 0:
