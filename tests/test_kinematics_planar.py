@@ -206,7 +206,7 @@ def test_float32_torch_and_jax(rng, torch, jnp):
 
 def test_integration_errors():
     w = np.ones((5, 1))
-    with pytest.raises(rk.FrameKeywordError, match="frame"):
+    with pytest.raises(TypeError, match="'frame'"):
         P.integrate_angular_velocity(rk.Rotation2D.identity(), w, 0.1)
     with pytest.raises(rk.ShapeError, match=r"w\[:, None\]"):
         P.integrate_angular_velocity(
@@ -264,7 +264,7 @@ def test_velocities_from_samples_second_order(frame):
 
 def test_velocities_from_samples_errors():
     R = rk.Rotation2D.from_angle([0.0, 0.1, 0.2])
-    with pytest.raises(rk.FrameKeywordError, match="frame"):
+    with pytest.raises(TypeError, match="'frame'"):
         P.angular_velocity_from_samples(R, [0.0, 1.0, 2.0])
     with pytest.raises(rk.DegenerateInputError, match="increase"):
         P.angular_velocity_from_samples(R, [0.0, 1.0, 1.0], frame="body")

@@ -152,7 +152,7 @@ def euler_matrix(seq, symbols=None):
     return sp.Matrix(3, 3, [_full_angles(_exact(sp.sympify(e)), pairs) for e in m])
 
 
-def euler_rate_matrix(seq, symbols=None, *, frame=None):
+def euler_rate_matrix(seq, symbols=None, *, frame):
     """``E`` with ``omega = E @ d(angles)/dt`` over symbols, as ``sympy.Matrix``.
 
     From the kernel ``rate_matrix_from_euler`` (all 24 sequences; ``frame`` as in

@@ -54,7 +54,7 @@ def _tol(tol, a):
     return gimbal_lock_threshold(getattr(a, "dtype", None)) if tol is None else tol
 
 
-def euler_rate_matrix(seq, angles, *, frame=None, degrees=False):
+def euler_rate_matrix(seq, angles, *, frame, degrees=False):
     """The Euler-rate matrix ``E``: ``omega = E @ d(angles)/dt``.
 
     Parameters
@@ -94,7 +94,7 @@ def euler_rate_matrix(seq, angles, *, frame=None, degrees=False):
     return _k.rate_matrix_from_euler(*p, a)
 
 
-def euler_rate_matrix_inverse(seq, angles, *, frame=None, degrees=False, tol=None):
+def euler_rate_matrix_inverse(seq, angles, *, frame, degrees=False, tol=None):
     """``E^-1``: ``d(angles)/dt = E^-1 @ omega``; raises at gimbal lock.
 
     Parameters
@@ -132,7 +132,7 @@ def euler_rate_matrix_inverse(seq, angles, *, frame=None, degrees=False, tol=Non
     return inv
 
 
-def euler_rate_matrix_derivative(seq, angles, rates, *, frame=None, degrees=False):
+def euler_rate_matrix_derivative(seq, angles, rates, *, frame, degrees=False):
     """``dE/dt`` for angles changing at ``rates``, exact (cross products of the axes).
 
     Parameters
@@ -158,7 +158,7 @@ def euler_rate_matrix_derivative(seq, angles, rates, *, frame=None, degrees=Fals
     return _k.rate_matrix_derivative_from_euler(*p, a, vector(rates, (3,), "Euler rates"))
 
 
-def angular_velocity_from_euler_rates(seq, angles, rates, *, frame=None, degrees=False):
+def angular_velocity_from_euler_rates(seq, angles, rates, *, frame, degrees=False):
     """``omega = E(angles) @ rates`` (fused; ``E`` is not stored).
 
     Parameters
@@ -187,7 +187,7 @@ def angular_velocity_from_euler_rates(seq, angles, rates, *, frame=None, degrees
     return _k.omega_from_euler_rates(*p, a, vector(rates, (3,), "Euler rates"))
 
 
-def euler_rates(seq, angles, omega, *, frame=None, degrees=False, tol=None):
+def euler_rates(seq, angles, omega, *, frame, degrees=False, tol=None):
     """Euler-angle rates ``E^-1 @ omega``; raises :class:`GimbalLockError` at the lock.
 
     Parameters
@@ -225,7 +225,7 @@ def euler_rates(seq, angles, omega, *, frame=None, degrees=False, tol=None):
 
 
 def angular_acceleration_from_euler_rates(
-    seq, angles, rates, accelerations, *, frame=None, degrees=False
+    seq, angles, rates, accelerations, *, frame, degrees=False
 ):
     """``alpha = E @ d2(angles)/dt2 + (dE/dt) @ rates``, ``dE/dt`` exact.
 
@@ -258,7 +258,7 @@ def angular_acceleration_from_euler_rates(
     return _k.alpha_from_euler_accelerations(*p, a, r, d)
 
 
-def euler_accelerations(seq, angles, rates, alpha, *, frame=None, degrees=False, tol=None):
+def euler_accelerations(seq, angles, rates, alpha, *, frame, degrees=False, tol=None):
     """Second derivatives of the angles, ``E^-1 (alpha - (dE/dt) @ rates)``.
 
     Parameters

@@ -138,7 +138,7 @@ def _samples(rate, width, what, fn):
     return r
 
 
-def integrate_angular_velocity(R0, omega, dt, *, frame=None, method="exact"):
+def integrate_angular_velocity(R0, omega, dt, *, frame, method="exact"):
     """Orientation trajectory of a body turning at the sampled rates ``omega``.
 
     Body frame (gyroscope rates): ``R' = R hat(omega)``; world frame:
@@ -190,7 +190,7 @@ def integrate_angular_velocity(R0, omega, dt, *, frame=None, method="exact"):
     )
 
 
-def integrate_twist(T0, twist, dt, *, frame=None, method="exact"):
+def integrate_twist(T0, twist, dt, *, frame, method="exact"):
     """Pose trajectory of a body moving with the sampled twists ``(v, omega)``.
 
     Body frame (dead reckoning from velocities measured on the vehicle, ``v`` the

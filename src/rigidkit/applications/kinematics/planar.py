@@ -61,7 +61,7 @@ def _transform(T):
     return m
 
 
-def angular_velocity(R, R_dot, *, frame=None):
+def angular_velocity(R, R_dot, *, frame):
     """``omega`` with ``R' = omega J R``; the same in the world and body frame.
 
     Parameters
@@ -79,7 +79,7 @@ def angular_velocity(R, R_dot, *, frame=None):
     return _k.omega_from_matrix_derivative_2d(_rotation(R), vector(R_dot, (2, 2), "R_dot"))
 
 
-def rotation_derivative(R, omega, *, frame=None):
+def rotation_derivative(R, omega, *, frame):
     """``R' = omega J R`` (= ``R omega J``).
 
     Parameters
@@ -107,7 +107,7 @@ def rotation_derivative(R, omega, *, frame=None):
     )
 
 
-def twist_from_derivative(T, T_dot, *, frame=None):
+def twist_from_derivative(T, T_dot, *, frame):
     """Planar twist ``(vx, vy, omega)``: ``hat(V) = T' T^-1`` (world) or ``T^-1 T'``.
 
     Parameters
@@ -126,7 +126,7 @@ def twist_from_derivative(T, T_dot, *, frame=None):
     )
 
 
-def transform_derivative(T, twist, *, frame=None):
+def transform_derivative(T, twist, *, frame):
     """``T' = hat(V) T`` (world) or ``T hat(V)`` (body), planar twists ``(vx, vy, omega)``.
 
     Parameters
@@ -257,7 +257,7 @@ def point_acceleration(
     )
 
 
-def integrate_angular_velocity(R0, omega, dt, *, frame=None, method="exact"):
+def integrate_angular_velocity(R0, omega, dt, *, frame, method="exact"):
     """Planar orientations of a body turning at the sampled rates ``omega``.
 
     SO(2) is commutative, so ``R_N = R_0 exp(J theta_N)`` with ``theta_N`` the
@@ -302,7 +302,7 @@ def integrate_angular_velocity(R0, omega, dt, *, frame=None, method="exact"):
     return integrate_from(R0, omega, dt, method, frame, fn, Rotation2D, _rotation)
 
 
-def integrate_twist(T0, twist, dt, *, frame=None, method="exact"):
+def integrate_twist(T0, twist, dt, *, frame, method="exact"):
     """Planar poses of a body moving with the sampled twists ``(vx, vy, omega)``.
 
     Body frame (odometry: ``v`` the velocity of the body origin in its own axes):
@@ -340,7 +340,7 @@ def integrate_twist(T0, twist, dt, *, frame=None, method="exact"):
     return integrate_from(T0, twist, dt, method, frame, fn, Transform2D, _transform)
 
 
-def angular_velocity_from_samples(rotations, times, *, frame=None):
+def angular_velocity_from_samples(rotations, times, *, frame):
     """Planar angular velocity at each sample of an orientation trajectory.
 
     The finite differences on the group of
@@ -375,7 +375,7 @@ def angular_velocity_from_samples(rotations, times, *, frame=None):
     return from_samples(rotations, times, frame, fn, Rotation2D, _rotation, "rotations")
 
 
-def twist_from_samples(transforms, times, *, frame=None):
+def twist_from_samples(transforms, times, *, frame):
     """Planar twist ``(vx, vy, omega)`` at each sample of a pose trajectory.
 
     The finite differences on the group of

@@ -26,7 +26,7 @@ __all__ = [
 ]
 
 
-def angular_velocity(R, R_dot, *, frame=None):
+def angular_velocity(R, R_dot, *, frame):
     """Angular velocity of a turning frame from its rotation matrix and derivative.
 
     World: ``hat(omega) = R' R^T``; body: ``hat(omega) = R^T R'``
@@ -64,7 +64,7 @@ def angular_velocity(R, R_dot, *, frame=None):
     return _k.omega_from_matrix_derivative(body, m, vector(R_dot, (3, 3), "R_dot"))
 
 
-def rotation_derivative(R, omega, *, frame=None):
+def rotation_derivative(R, omega, *, frame):
     """``dR/dt``: ``hat(omega) R`` (world) or ``R hat(omega)`` (body).
 
     Parameters
@@ -95,7 +95,7 @@ def rotation_derivative(R, omega, *, frame=None):
     return _k.matrix_derivative_from_omega(body, m, vector(omega, (3,), "angular velocity"))
 
 
-def angular_acceleration(R, R_dot, R_ddot, *, frame=None):
+def angular_acceleration(R, R_dot, R_ddot, *, frame):
     """Angular acceleration ``d omega/dt`` from ``R``, ``R'`` and ``R''``.
 
     ``hat(alpha) = R'' R^T + R' R'^T`` (world) and ``R' R'^T = -hat(omega)^2`` is
@@ -133,7 +133,7 @@ def angular_acceleration(R, R_dot, R_ddot, *, frame=None):
     return _k.alpha_from_matrix_second_derivative(body, m, vector(R_ddot, (3, 3), "R_ddot"))
 
 
-def rotation_second_derivative(R, omega, alpha, *, frame=None):
+def rotation_second_derivative(R, omega, alpha, *, frame):
     """``R'' = (hat(alpha) + hat(omega)^2) R`` (world) or ``R (hat(alpha) + hat(omega)^2)``.
 
     The matrix form of the rotational acceleration: differentiate
@@ -169,7 +169,7 @@ def rotation_second_derivative(R, omega, alpha, *, frame=None):
     )
 
 
-def quaternion_derivative(q, omega, *, frame=None):
+def quaternion_derivative(q, omega, *, frame):
     """``q' = q (0, omega) / 2`` (body) or ``(0, omega) q / 2`` (world), Hamilton.
 
     Parameters
@@ -197,7 +197,7 @@ def quaternion_derivative(q, omega, *, frame=None):
     return _k.quat_derivative(body, quaternion(q), vector(omega, (3,), "angular velocity"))
 
 
-def quaternion_second_derivative(q, omega, alpha, *, frame=None):
+def quaternion_second_derivative(q, omega, alpha, *, frame):
     """``q'' = q (-|omega|^2/4, alpha/2)`` (body) or ``(-|omega|^2/4, alpha/2) q`` (world).
 
     Parameters
@@ -222,7 +222,7 @@ def quaternion_second_derivative(q, omega, alpha, *, frame=None):
     return _k.quat_second_derivative(body, quaternion(q), w, a)
 
 
-def angular_velocity_from_quaternion_derivative(q, q_dot, *, frame=None):
+def angular_velocity_from_quaternion_derivative(q, q_dot, *, frame):
     """``omega = 2 vec(q* q') / |q|^2`` (body) or ``2 vec(q' q*) / |q|^2`` (world).
 
     Any scale of ``q`` (a changing norm only affects the scalar part).

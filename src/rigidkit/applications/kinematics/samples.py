@@ -134,7 +134,7 @@ def _adjoint_apply(X, tau):
     return (X.adjoint() @ tau[..., None])[..., 0]
 
 
-def angular_velocity_from_samples(rotations, times, *, frame=None):
+def angular_velocity_from_samples(rotations, times, *, frame):
     """Angular velocity at each sample of an orientation trajectory.
 
     Parameters
@@ -166,7 +166,7 @@ def angular_velocity_from_samples(rotations, times, *, frame=None):
     return from_samples(rotations, times, frame, fn, Rotation, rotation_matrix, "rotations")
 
 
-def twist_from_samples(transforms, times, *, frame=None):
+def twist_from_samples(transforms, times, *, frame):
     """Twist ``(v, omega)`` at each sample of a pose trajectory.
 
     Parameters

@@ -36,7 +36,7 @@ screw_from_twist = _screw.screw_from_twist
 twist_from_screw = _screw.twist_from_screw
 
 
-def twist_from_derivative(T, T_dot, *, frame=None):
+def twist_from_derivative(T, T_dot, *, frame):
     """Twist ``(v, omega)`` of a moving frame: ``hat(V) = T' T^-1`` or ``T^-1 T'``.
 
     World: ``omega = vee(R' R^T)``, ``v = p' - omega x p`` (the spatial velocity of
@@ -76,7 +76,7 @@ def twist_from_derivative(T, T_dot, *, frame=None):
     return _k.twist_from_matrix_derivative(body, m, vector(T_dot, (4, 4), "T_dot"))
 
 
-def transform_derivative(T, twist, *, frame=None):
+def transform_derivative(T, twist, *, frame):
     """``dT/dt = hat(V) T`` (world) or ``T hat(V)`` (body).
 
     Parameters
@@ -105,7 +105,7 @@ def transform_derivative(T, twist, *, frame=None):
     return _k.matrix_derivative_from_twist(body, m, vector(twist, (6,), "twist"))
 
 
-def transform_second_derivative(T, twist, twist_dot, *, frame=None):
+def transform_second_derivative(T, twist, twist_dot, *, frame):
     """``T'' = (hat(V') + hat(V)^2) T`` (world) or ``T (hat(V') + hat(V)^2)`` (body).
 
     Parameters
@@ -135,7 +135,7 @@ def transform_second_derivative(T, twist, twist_dot, *, frame=None):
     )
 
 
-def spatial_acceleration_matrix(twist, twist_dot, *, frame=None):
+def spatial_acceleration_matrix(twist, twist_dot, *, frame):
     """``hat(V') + hat(V)^2 = [[hat(alpha) + hat(omega)^2, v' + omega x v], [0, 0]]``.
 
     For world twists, ``q'' = M [q; 1]`` is the acceleration of the body point at

@@ -309,7 +309,7 @@ class Trajectory:
             self._stamps, Transform(rotation=rotation, translation=translation)
         )
 
-    def velocities(self, frame=None):
+    def velocities(self, frame):
         """Twists ``(v, omega)`` at each pose, shape (..., N, 6), from the samples.
 
         :func:`rigidkit.kinematics.twist_from_samples` on the stamps (the index
