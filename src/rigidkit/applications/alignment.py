@@ -19,7 +19,7 @@ from ..objects.transform import Transform
 __all__ = ["align_vectors", "align_points"]
 
 
-def align_vectors(a, b, weights=None):
+def align_vectors(a, b, weights=None, *, return_sensitivity=False):
     """The rotation ``R`` minimising ``sum_i w_i |a_i - R b_i|^2``, and its residual.
 
     Exact (to rounding) for noiseless data, for a single pair (the shortest arc
@@ -31,9 +31,16 @@ def align_vectors(a, b, weights=None):
     a : array_like, shape (..., N, 3)
         Vectors in frame A.
     b : array_like, shape (..., N, 3)
-        The same vectors in frame B; batch shapes broadcast.
+        The same vectors in frame B; batch shapes broadcast (only they: the
+        numbers of pairs ``N`` must be equal).
     weights : array_like, shape (..., N), optional
-        Non-negative weights (equal if omitted).
+        Non-negative weights (equal if omitted). One weight of a problem may be
+        ``inf``: that pair is then aligned exactly and the others only fix the
+        turn about it (scipy's primary vector).
+    return_sensitivity : bool
+        Also return the sensitivity matrix (Markley 1993): times the variance
+        of the vectors' angular errors, the covariance of the rotation vector
+        error of ``R``; see :func:`rigidkit.functional.alignment.kabsch`.
 
     Returns
     -------
@@ -41,14 +48,21 @@ def align_vectors(a, b, weights=None):
         ``A_R_B``.
     rssd : array, shape (...)
         ``sqrt(sum_i w_i |a_i - R b_i|^2)``, computed from the residuals (noiseless
-        data gives ~1e-15, not the ~1e-7 of scipy's cancelling formula).
+        data gives ~1e-15, not the ~1e-7 of scipy's cancelling formula); an
+        infinitely weighted pair counts 0.
+    sensitivity : array, shape (..., 3, 3)
+        Only with ``return_sensitivity=True``.
 
     Raises
     ------
+    ShapeError
+        Different numbers of pairs in ``a`` and ``b``; ``weights`` not of shape
+        ``(..., N)``.
     DegenerateInputError
-        Negative weights, or all pairs zero or of zero weight.
+        Negative weights, all pairs zero or of zero weight, more than one
+        infinite weight in a problem, or a sensitivity asked for with one.
     NonFiniteError
-        NaN or infinity in the input.
+        NaN or infinity in the input (other than an ``inf`` weight).
 
     Examples
     --------
@@ -59,9 +73,12 @@ def align_vectors(a, b, weights=None):
     >>> R, rssd = rk.align_vectors(A_R_B @ b, b)
     >>> bool(R.approx_equal(A_R_B, atol=1e-14)), bool(rssd < 1e-13)
     (True, True)
+    >>> R, rssd, sensitivity = rk.align_vectors(A_R_B @ b, b, return_sensitivity=True)
+    >>> sensitivity.shape
+    (3, 3)
     """
-    quat, rssd = _fa.kabsch(a, b, weights)
-    return spec(Rotation).wrap(quat), rssd
+    out = _fa.kabsch(a, b, weights, return_sensitivity=return_sensitivity)
+    return (spec(Rotation).wrap(out[0]),) + tuple(out[1:])
 
 
 def align_points(src, dst, weights=None, *, scale=False):
