@@ -199,6 +199,36 @@ def test_tum_errors_name_file_line_and_reason(tmp_path, text, line, message):
     assert err.line == line and err.path == str(path)
 
 
+@pytest.mark.parametrize("fmt", ["tum", "euroc", "csv"])
+def test_zero_quaternion_named_in_a_long_file(tmp_path, fmt):
+    # The row of the first zero quaternion among many (the conversion's batch
+    # index), as a file line after the header.
+    traj = _traj(3000)
+    path = tmp_path / f"a.{fmt}"
+    write(path, traj, fmt)
+    lines = path.read_text().splitlines(keepends=True)
+    for row in (1234, 2000):  # two zeros: the first is named
+        fields = lines[1 + row].rstrip("\n").split("," if fmt != "tum" else " ")
+        fields[-4:] = ["0"] * 4  # the quaternion: the last 4 fields
+        lines[1 + row] = ("," if fmt != "tum" else " ").join(fields) + "\n"
+    path.write_text("".join(lines))
+    with pytest.raises(rk.TrajectoryFileError, match="quaternion has zero norm") as info:
+        read(path, fmt)
+    assert info.value.line == 1235 + 1 and info.value.index == (1234,)
+
+
+def test_detection_past_the_first_4_kib(tmp_path):
+    # Comments longer than the first block the detection decodes.
+    path = tmp_path / "a.txt"
+    comments = "".join(f"# comment line {k} " + "x" * 60 + "\n" for k in range(100))
+    path.write_text(comments + "\n" * 3 + "1.0 1 2 3 0 0 0 1\n2.0 1 2 4 0 0 0 1\n")
+    traj = read(path)
+    assert traj.stamps.tolist() == [1.0, 2.0] and traj.positions[1].tolist() == [1, 2, 4]
+    csv = tmp_path / "b.csv"
+    csv.write_text("\n" * 5000 + "t,x,y,z,qw,qx,qy,qz\n1,2,3,4,1,0,0,0\n")
+    assert read(csv).positions.tolist() == [[2.0, 3.0, 4.0]]
+
+
 def test_kitti_rejects_a_matrix_that_is_not_a_rotation(tmp_path):
     good = "1 0 0 0 0 1 0 0 0 0 1 0\n"
     path = tmp_path / "poses.txt"

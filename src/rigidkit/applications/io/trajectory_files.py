@@ -30,7 +30,7 @@ import warnings
 
 import numpy as np
 
-from ...errors import TimestampError, TrajectoryFileError
+from ...errors import TimestampError, TrajectoryFileError, ZeroNormError
 from ...objects.transform import Transform
 from ..trajectory.trajectory import Trajectory, check_stamps
 from ._csv_header import column_of, csv_delimiter
@@ -99,21 +99,28 @@ class _Text:
         """The first 64 KiB as text: enough to tell the format."""
         return self.data[:65536].decode("utf-8", "replace")
 
+    def head_lines(self, where):
+        """The first ``(number, line)`` of the head for which ``where(line)`` holds.
+
+        The first 4 KiB (cut after their last whole line) are decoded first and
+        the 64 KiB head only when they hold no such line: decoding and splitting
+        the whole head cost a 21,000-line file a tenth of its reading.
+        """
+        for size in (4096, 65536):
+            chunk = self.data[:size]
+            if size < len(self.data):
+                chunk = chunk[: chunk.rfind(b"\n") + 1]
+            lines = chunk.decode("utf-8", "replace").splitlines()
+            found = next(((n, x) for n, x in enumerate(lines, start=1) if where(x)), None)
+            if found is not None or size >= len(self.data):
+                return found
+        return None
+
     @property
     def lines(self):
         if self._lines is None:
             self._lines = self.data.decode("utf-8", "replace").splitlines()
         return self._lines
-
-    def first_lines(self, count=2):
-        """The first ``count`` lines that are not blank (comments included)."""
-        out = []
-        for n, line in enumerate(self.head.splitlines()[:200], start=1):
-            if line.strip():
-                out.append((n, line))
-                if len(out) == count:
-                    break
-        return out
 
 
 def _table(src: _Text, delimiter, ncols: int, exact: bool, skip: int, what: str):
@@ -182,12 +189,13 @@ def _checked_stamps(src, stamps, rows):
 
 def _poses_from_pq(src, pq, scalar_first, rows):
     """Poses from rows ``(x, y, z)`` and a quaternion of any nonzero norm."""
-    q = pq[:, 3:]
-    bad = ~(np.einsum("ij,ij->i", q, q) > 0.0)
-    if bad.any():
-        row = int(np.argmax(bad))
-        _fail(src.path, rows()[row], "the quaternion has zero norm", row)
-    return Transform.from_pq(np.ascontiguousarray(pq), scalar_first=scalar_first)
+    # The conversion checks the norms itself (no pass of its own over them
+    # here) and names the first zero one's row.
+    try:
+        return Transform.from_pq(np.ascontiguousarray(pq), scalar_first=scalar_first)
+    except ZeroNormError as exc:
+        row = exc.index[0]
+    _fail(src.path, rows()[row], "the quaternion has zero norm", row)
 
 
 # -- the formats -----------------------------------------------------------------------
@@ -247,14 +255,7 @@ def _read_euroc(src):
 
 
 def _read_csv(src):
-    first = next(
-        (
-            (n, line)
-            for n, line in enumerate(src.head.splitlines(), start=1)
-            if line.strip()
-        ),
-        None,
-    )
+    first = src.head_lines(str.strip)
     if first is None:
         _fail(src.path, None, "is empty; a CSV trajectory needs a header line")
     n, header = first
@@ -307,22 +308,15 @@ def _read_csv(src):
 
 
 def _detect(src) -> str:
-    lines = src.first_lines(2)
-    if not lines:
+    first = src.head_lines(str.strip)
+    if first is None:
         _fail(src.path, None, "is empty: no pose to read")
-    n, line = lines[0]
+    n, line = first
     low = line.lower()
     if low.startswith("#"):
         if "," in low and "timestamp" in low and ("q_" in low or "qw" in low):
             return "euroc"
-        data = next(
-            (
-                (m, x)
-                for m, x in enumerate(src.head.splitlines(), start=1)
-                if not _is_skipped(x)
-            ),
-            None,
-        )
+        data = src.head_lines(lambda x: not _is_skipped(x))
         if data is None:
             _fail(src.path, None, "holds no pose (only comments)")
         n, line = data
