@@ -163,6 +163,42 @@ def test_interpolation_is_rk_slerp(decoupled):
         np.testing.assert_allclose(one, want[k], atol=1e-14)
 
 
+def test_decoupled_kernels_from_segment_steps_are_slerp():
+    """The kernels of the batched decoupled lookup, ``q0 d^t`` from the relative
+    rotation ``d = q0* q1`` and the position ``p0 + t (p1 - p0)``, against
+    ``quat_slerp`` and ``pose_slerp_decoupled`` of the two ends (including
+    opposite quaternions and coincident ends), in float64 and float32."""
+    from rigidkit.kernels.geodesic import (
+        pose_from_quat_lerp,
+        pose_slerp_decoupled,
+        quat_slerp,
+        quat_slerp_relative,
+    )
+    from rigidkit.kernels.quaternion import quat_multiply
+
+    rng = np.random.default_rng(21)
+    n = 3000
+    q0 = np.asarray(rk.Rotation.random(n, rng=rng).as_quat())
+    q1 = np.array(rk.Rotation.random(n, rng=rng).as_quat())
+    q1[:10] = -q0[:10]  # the same rotation, opposite signs
+    q1[10:20] = q0[10:20]
+    p0, p1 = rng.normal(size=(n, 3)), rng.normal(size=(n, 3))
+    t = rng.uniform(-0.5, 1.5, n)
+    for dtype, tol in ((np.float64, 1e-14), (np.float32, 2e-6)):
+        a, b, s = q0.astype(dtype), q1.astype(dtype), t.astype(dtype)
+        d = quat_multiply(a * np.array([1, -1, -1, -1], dtype), b)
+        got = quat_slerp_relative(a, d, s)
+        assert got.dtype == dtype
+        np.testing.assert_allclose(got, quat_slerp(a, b, s), atol=tol)
+        pose = pose_from_quat_lerp(got, p0.astype(dtype), (p1 - p0).astype(dtype), s)
+        want = pose_slerp_decoupled(
+            np.concatenate([a, p0.astype(dtype)], -1),
+            np.concatenate([b, p1.astype(dtype)], -1),
+            s,
+        )
+        np.testing.assert_allclose(pose, want, atol=4 * tol)
+
+
 @pytest.mark.parametrize("interpolation", ["decoupled", "screw"])
 def test_times_in_order_match_times_in_any_order(robot, interpolation):
     """Times in increasing order (more of them than samples) find their segments

@@ -56,11 +56,17 @@ def quat_power(w, x, y, z, t):
 
 
 @helper
+def quat_times_power(w0, x0, y0, z0, dw, dx, dy, dz, t):
+    """``q0 d^t``: the slerp from ``q0`` along its relative rotation ``d = q0* q1``."""
+    pw, px, py, pz = quat_power_entries(dw, dx, dy, dz, t)
+    return quat_multiply(w0, x0, y0, z0, pw, px, py, pz)
+
+
+@helper
 def quat_slerp_entries(w0, x0, y0, z0, w1, x1, y1, z1, t):
     """``q0 (q0* q1)^t``, the shortest geodesic from ``q0`` (t = 0) to ``q1`` (t = 1)."""
     dw, dx, dy, dz = quat_multiply(w0, -x0, -y0, -z0, w1, x1, y1, z1)
-    pw, px, py, pz = quat_power_entries(dw, dx, dy, dz, t)
-    return quat_multiply(w0, x0, y0, z0, pw, px, py, pz)
+    return quat_times_power(w0, x0, y0, z0, dw, dx, dy, dz, t)
 
 
 @kernel(inputs=[(4,), (4,), ()], outputs=[(4,)], vector_math=True)
@@ -73,6 +79,28 @@ def quat_slerp(w0, x0, y0, z0, w1, x1, y1, z1, t):
     and ``q0 = -q1`` are exact.
     """
     return quat_slerp_entries(w0, x0, y0, z0, w1, x1, y1, z1, t)
+
+
+@kernel(inputs=[(4,), (4,), ()], outputs=[(4,)], vector_math=True)
+def quat_slerp_relative(w0, x0, y0, z0, dw, dx, dy, dz, t):
+    """:func:`quat_slerp` from ``q0`` and the relative rotation ``d = q0* q1``: ``q0 d^t``.
+
+    The same expression as :func:`quat_slerp` once ``d`` is known, for many ``t``
+    between the same two rotations (samples of a time series: ``d`` is taken once
+    per pair). One fused pass, vectorised like :func:`quat_slerp`.
+    """
+    return quat_times_power(w0, x0, y0, z0, dw, dx, dy, dz, t)
+
+
+@kernel(inputs=[(4,), (3,), (3,), ()], outputs=[(7,)])
+def pose_from_quat_lerp(w, x, y, z, px, py, pz, dx, dy, dz, t):
+    """The pose ``(q, p + t d)``: a rotation and the point ``t`` of the way along ``d``.
+
+    With ``d = p1 - p0`` this is the translation of decoupled interpolation
+    (:func:`pose_slerp_decoupled`) from a step taken once per pair of samples,
+    packed with its rotation in the pose layout ``(w, x, y, z, tx, ty, tz)``.
+    """
+    return (w, x, y, z, px + t * dx, py + t * dy, pz + t * dz)
 
 
 @helper
