@@ -382,6 +382,24 @@ def test_connectivity_and_lookup_errors(robot):
     assert not ok and "camra" in reason
 
 
+def test_lookup_error_is_also_the_builtin_kind_and_no_star_import_shadows_it(robot):
+    """rk.LookupError is a RigidkitError (a ValueError) and a builtin LookupError, so
+    ``except LookupError`` catches it; ``from rigidkit import *`` leaves the builtin
+    name alone, so ``except LookupError`` still catches KeyError after it."""
+    import builtins
+
+    g, _ = robot
+    with pytest.raises(builtins.LookupError) as err:
+        g.get("map", "camra")
+    assert type(err.value) is rk.LookupError and isinstance(err.value, rk.RigidkitError)
+    assert rk.LookupError is not builtins.LookupError
+    assert pickle.loads(pickle.dumps(err.value)).args == err.value.args
+    space = {}
+    exec("from rigidkit import *", space)
+    assert "LookupError" not in space and "ExtrapolationError" in space
+    assert rk.LookupError is rk.errors.LookupError
+
+
 # -- time travel and velocities ---------------------------------------------------------
 def test_time_travel(robot):
     g, data = robot

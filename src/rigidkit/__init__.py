@@ -126,8 +126,9 @@ __all__ = [
     "jacobians",
     # the validation switch (docs/architecture.md, "Validation policy")
     "set_validation",
-    # errors and warnings
-    *_error_names,
+    # errors and warnings; rk.LookupError (also a builtin LookupError) is left out,
+    # so that a star import does not shadow Python's own name
+    *(name for name in _error_names if name != "LookupError"),
 ]
 
 

@@ -6,6 +6,8 @@ and, for batches, at which batch index.
 
 from __future__ import annotations
 
+import builtins
+
 __all__ = [
     "RigidkitError",
     "NotARotationError",
@@ -265,11 +267,21 @@ class ConnectivityError(RigidkitError):
     them; the message names the root of each tree."""
 
 
-class LookupError(RigidkitError):  # shadows the builtin on purpose: rk.LookupError
+class LookupError(RigidkitError, builtins.LookupError):  # the builtin's name, on purpose
     """A frame name that the frame graph does not hold; the message lists the
-    closest names. A :class:`ValueError`, unlike Python's builtin ``LookupError``.
+    closest names.
+
+    Both a :class:`ValueError` (a :class:`RigidkitError`, like every rigidkit
+    input error) and a subclass of Python's builtin ``LookupError``, so
+    ``except LookupError``, ``except ValueError`` and ``except rk.LookupError``
+    all catch it. It is not the builtin itself, and so that ``from rigidkit
+    import *`` does not replace the builtin name (``except LookupError`` must
+    keep catching ``KeyError`` and ``IndexError``) it is left out of
+    ``rigidkit.__all__``: use it as ``rk.LookupError``.
 
     >>> import builtins
-    >>> issubclass(LookupError, ValueError), LookupError is builtins.LookupError
-    (True, False)
+    >>> issubclass(LookupError, ValueError), issubclass(LookupError, builtins.LookupError)
+    (True, True)
+    >>> LookupError is builtins.LookupError
+    False
     """
