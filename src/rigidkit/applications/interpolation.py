@@ -12,9 +12,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._engine import owned_function
-from .._engine.namespace import device_of, namespace_of
-from .._validate import finite_array, to_numpy
+from .._engine import dask_backend, owned_function
+from .._engine.namespace import device_of, is_torch, namespace_of
+from .._validate import (
+    as_float,
+    checks_now,
+    finite_array,
+    to_numpy,
+    validation_enabled,
+)
 from ..errors import DegenerateInputError, OutOfRangeError, ShapeError
 from ..functional import interpolation as _fi
 from ..kernels import geodesic as _kg
@@ -138,22 +144,51 @@ def keyframe_times(times, count, what="keyframes"):
 
 
 def query_times(times, lo, hi, *, extrapolate=False):
-    """Query ``times`` as a float64 NumPy array (any shape), checked within [lo, hi].
+    """Query ``times`` (any shape), checked finite and within [lo, hi].
 
-    ``extrapolate=True`` accepts any finite time (no range check).
+    The times stay in the caller's namespace (a traced JAX array under ``jit``, a
+    torch tensor under ``torch.compile``, a lazy Dask array): the checks read
+    values only where they can (:func:`rigidkit.set_validation`); on Dask they
+    run at compute time. Integer NumPy input becomes float64. ``extrapolate=True``
+    accepts any finite time (no range check).
     """
-    q = np.asarray(to_numpy(finite_array(times, (), "times")), dtype=np.float64)
+    q = as_float(finite_array(times, (), "times"))
     if extrapolate:
         return q
-    out = (q < lo) | (q > hi)
+    lo, hi = float(lo), float(hi)
+    if checks_now(q):
+        _check_range(np.asarray(to_numpy(q)), lo, hi)
+    elif validation_enabled() and dask_backend.is_dask(q):
+        # at compute time, per chunk, in whatever is computed from the times
+        dask_backend.defer(_check_range, (q,), (lo, hi), _relabel)
+    return q
+
+
+def _check_range(t, lo, hi):
+    """:class:`OutOfRangeError` at the first time of NumPy ``t`` outside [lo, hi]."""
+    out = (t < lo) | (t > hi)
     if out.any():
         idx = tuple(int(i) for i in np.argwhere(out)[0])
         raise OutOfRangeError(
-            f"time {float(q[idx])!r} {'at index ' + str(idx) + ' ' if idx else ''}is "
-            f"outside the interpolation range [{float(lo)!r}, {float(hi)!r}]",
+            f"time {float(t[idx])!r} {'at index ' + str(idx) + ' ' if idx else ''}is "
+            f"outside the interpolation range [{lo!r}, {hi!r}]",
             index=idx,
         )
-    return q
+
+
+def _relabel(err, index):
+    """The error of a chunk naming the ``index`` in the whole array."""
+    text = str(err).replace(f"at index {err.index}", f"at index {index}", 1)
+    return type(err)(text, index=index)
+
+
+def astype_like(x, like):
+    """``x`` with the dtype of ``like`` (both of one namespace)."""
+    if x.dtype == like.dtype:
+        return x
+    if is_torch(x):
+        return x.to(like.dtype)
+    return x.astype(like.dtype)
 
 
 def keyframe_kind(keyframes, least, what):
@@ -208,38 +243,23 @@ class Slerp:
         """The interpolated keyframes at ``times`` (shape (...) -> batch (..., extra)).
 
         Raises :class:`~rigidkit.OutOfRangeError` outside ``[times[0], times[-1]]``.
+        The result is of the namespace of the keyframes or of ``times`` (NumPy
+        keyframes meet JAX, torch or Dask times: it traces and stays lazy).
         """
         q = query_times(times, self.times[0], self.times[-1])
+        data = stored(self.keyframes)
+        q = _fi.meet(q, data)  # NumPy times meet the keyframes' namespace
+        data = _fi.meet(data, q)  # NumPy keyframes meet the times'
         flat = q.reshape(-1)
         idx = _fi.segment_index(self.times, flat)
-        alpha = (flat - self.times[idx]) / self._dt[idx]
-        data = stored(self.keyframes)
+        alpha = (flat - _fi.take_rows(self.times, idx)) / _fi.take_rows(self._dt, idx)
         extra = len(self.keyframes.shape) - 1
-        alpha = alpha.reshape(alpha.shape + (1,) * extra)
-        x0 = _take(data, idx)
-        x1 = _take(data, idx + 1)
-        alpha = _like(alpha, data)
+        alpha = astype_like(alpha.reshape(tuple(alpha.shape) + (1,) * extra), data)
+        x0 = _fi.take_rows(data, idx)
+        x1 = _fi.take_rows(data, idx + 1)
         if isinstance(self.keyframes, Transform):
             out = _fi.pose_slerp_unchecked(x0, x1, alpha, decoupled=self.decoupled)
         else:
             out = _fi.quat_slerp_unchecked(x0, x1, alpha)
         wrap = registry.spec(type(self.keyframes)).wrap
-        return wrap(out.reshape(q.shape + tuple(out.shape[1:])))
-
-
-def _take(data, idx):
-    """``data[idx]`` along the time axis, for any array namespace."""
-    if isinstance(data, np.ndarray):
-        return data[idx]
-    from .._engine.namespace import device_of, namespace_of
-
-    return data[namespace_of(data).asarray(idx, device=device_of(data))]
-
-
-def _like(values, data):
-    """NumPy ``values`` in the namespace, dtype and device of ``data``."""
-    if isinstance(data, np.ndarray):
-        return values.astype(data.dtype, copy=False)
-    from .._engine.namespace import device_of, namespace_of
-
-    return namespace_of(data).asarray(values, dtype=data.dtype, device=device_of(data))
+        return wrap(out.reshape(tuple(q.shape) + tuple(out.shape[1:])))

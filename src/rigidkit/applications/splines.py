@@ -41,7 +41,7 @@ def _check_order(order, frame):
 
 def _shape(out, q, k):
     """Results (q.size, extra..., k) reshaped to (q.shape, extra..., k)."""
-    return out.reshape(q.shape + tuple(out.shape[1:-1]) + (k,))
+    return out.reshape(tuple(q.shape) + tuple(out.shape[1:-1]) + (k,))
 
 
 class _Spline:
@@ -70,7 +70,7 @@ class _Spline:
         """
         _check_order(order, frame)
         q = query_times(times, self.t_min, self.t_max, extrapolate=self.extrapolate)
-        flat = q.reshape(-1)
+        flat = q.reshape(-1)  # the caller's namespace: traces, stays lazy on Dask
         wrap = registry.spec(self.kind).wrap
         if order == 0:
             out = self._eval(flat, 0)

@@ -17,7 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._engine.namespace import device_of, namespace_of
+from .._engine import dask_backend
+from .._engine.namespace import device_of, is_numpy, is_torch, namespace_of
 from .._validate import as_array, as_float, check_finite, finite_array
 from ..kernels import geodesic as _k
 from . import conversions as _conv
@@ -32,6 +33,10 @@ __all__ = [
     "pose_power_unchecked",
     "pose_slerp_unchecked",
     "segment_index",
+    "segment_index_numpy",
+    "uniform_segment",
+    "take_rows",
+    "meet",
 ]
 
 
@@ -182,18 +187,98 @@ def segment_index(knots, times):
 
     scipy's convention: intervals are closed on the right except that the first
     knot belongs to interval 0, so an interior knot ``knots[k]`` falls in interval
-    ``k - 1`` (at its end). NumPy-side (``searchsorted`` on concrete values).
+    ``k - 1`` (at its end). Times before the first knot get 0, after the last
+    ``n - 2`` (the end intervals, continued). The lookup runs in the namespace of
+    ``times`` (``searchsorted`` of NumPy, torch or JAX; per chunk on Dask), so it
+    traces under ``jax.jit`` and ``torch.compile`` and stays lazy on Dask.
 
     Parameters
     ----------
     knots : ndarray, shape (n,)
-        Strictly increasing.
-    times : ndarray, shape (...)
-        Within ``[knots[0], knots[-1]]`` (the caller checks).
+        Strictly increasing (NumPy).
+    times : array, shape (...)
+        Any array namespace.
 
     Returns
     -------
-    ndarray of intp, shape (...)
+    integer array of the namespace of ``times``, shape (...)
+
+    >>> segment_index(np.array([0.0, 1.0, 2.0]), np.array([-1.0, 0.0, 1.0, 1.5, 3.0]))
+    array([0, 0, 0, 1, 1])
     """
-    idx = np.searchsorted(knots, times, side="left") - 1
-    return np.clip(idx, 0, len(knots) - 2)
+    top = len(knots) - 2
+    if isinstance(times, (np.ndarray, np.generic, float, int)):
+        idx = np.searchsorted(knots, times, side="left") - 1
+        return np.clip(idx, 0, top)
+    if is_torch(times):
+        import torch
+
+        k = torch.as_tensor(knots, dtype=times.dtype, device=times.device)
+        idx = torch.searchsorted(k, times.contiguous(), side="left") - 1
+        return torch.clamp(idx, 0, top)
+    if dask_backend.is_dask(times):
+        return times.map_blocks(segment_index_numpy, knots, dtype=np.intp)
+    xp = namespace_of(times)
+    k = xp.asarray(knots, dtype=times.dtype)
+    return xp.clip(xp.searchsorted(k, times, side="left") - 1, 0, top)
+
+
+def segment_index_numpy(times, knots):
+    """:func:`segment_index` of a NumPy block (for Dask's ``map_blocks``)."""
+    return segment_index(knots, np.asarray(times))
+
+
+def uniform_segment(x, count):
+    """Segment ``s = clip(floor(x), 0, count - 1)`` and ``u = x - s`` of uniform knots.
+
+    ``x`` is the time in knot units; ``s`` is an integer array and ``u`` (in
+    [0, 1) inside the range, beyond it outside) an array of ``x``'s dtype, both
+    of the namespace of ``x`` (traces; lazy on Dask). The gradient of ``u`` with
+    respect to ``x`` is 1.
+
+    >>> s, u = uniform_segment(np.array([-0.5, 0.25, 1.0, 2.5]), 2)
+    >>> s, u
+    (array([0, 0, 1, 1]), array([-0.5 ,  0.25,  0.  ,  1.5 ]))
+    """
+    if is_torch(x):
+        import torch
+
+        s = torch.clamp(torch.floor(x), 0, count - 1)
+        return s.to(torch.int64), x - s
+    if isinstance(x, np.ndarray) or dask_backend.is_dask(x):
+        s = np.clip(np.floor(x), 0, count - 1)
+        return s.astype(np.intp), x - s
+    xp = namespace_of(x)
+    s = xp.clip(xp.floor(x), 0, count - 1)
+    return s.astype(xp.int32 if count < 2**31 else xp.int64), x - s
+
+
+def take_rows(x, idx):
+    """``x[idx]`` along the first axis; ``idx`` an integer array of any namespace.
+
+    NumPy ``x`` meets the namespace of ``idx`` first (a constant under ``jit``, a
+    one-chunk Dask array for Dask indices, a tensor on the device of ``idx``).
+    """
+    return meet(x, idx)[idx]
+
+
+def meet(x, like):
+    """``x`` in the namespace (and device) of ``like`` if ``x`` is NumPy; else ``x``.
+
+    The dtype of ``x`` is kept. Arrays of two special namespaces are returned as
+    they are (the caller's kernels report the mix).
+    """
+    if not isinstance(x, np.ndarray) or isinstance(like, (np.ndarray, np.generic)):
+        return x
+    if dask_backend.is_dask(like):
+        import dask.array as da
+
+        return da.from_array(x, chunks=x.shape)
+    if is_torch(like):
+        import torch
+
+        return torch.as_tensor(x, device=like.device)
+    xp = namespace_of(like)
+    if is_numpy(xp):
+        return x
+    return xp.asarray(x, device=device_of(like))

@@ -55,10 +55,6 @@ __all__ = [
 ]
 
 
-def _np(x):
-    return x if isinstance(x, np.ndarray) else np.asarray(x)
-
-
 def _const(xp, values, like):
     return xp.asarray(values, dtype=like.dtype, device=device_of(like))
 
@@ -66,11 +62,6 @@ def _const(xp, values, like):
 def _expand(h, ndim):
     """``h`` of shape (m,) reshaped to (m, 1, ..., 1) for ``ndim`` trailing axes."""
     return h.reshape((h.shape[0],) + (1,) * ndim)
-
-
-def _take(xp, x, index, device):
-    """``x[index]`` along the first axis, ``index`` a NumPy integer array."""
-    return x[index] if isinstance(x, np.ndarray) else x[xp.asarray(index, device=device)]
 
 
 def _matvec(m, v):
@@ -251,23 +242,32 @@ def rotation_spline_eval(times, quats, coeffs, query, order):
     array, shape (q, ..., 4) for order 0, else (q, ..., 3)
         Quaternions, body angular velocity or body angular acceleration.
     """
-    from .interpolation import segment_index
+    from .interpolation import meet, segment_index, take_rows
 
-    xp = namespace_of(quats)
-    idx = segment_index(np.asarray(times, dtype=np.float64), query)
-    tau = _np(query) - np.asarray(times, dtype=np.float64)[idx]
-    dev = device_of(quats)
-    cf = _take(xp, coeffs, idx, dev)
-    s = _expand(_const(xp, tau, coeffs), cf.ndim - 2)
+    query = meet(query, quats)  # NumPy times meet the keyframes' namespace
+    quats, coeffs = meet(quats, query), meet(coeffs, query)  # and the other way
+    idx = segment_index(times, query)
+    tau = query - take_rows(np.asarray(times, dtype=np.float64), idx)
+    cf = take_rows(coeffs, idx)
+    s = _expand(_astype(tau, coeffs), cf.ndim - 2)
     a, b, c = cf[..., 0, :], cf[..., 1, :], cf[..., 2, :]
     r = ((a * s + b) * s + c) * s
     if order == 0:
-        q = _take(xp, quats, idx, dev)
+        q = take_rows(quats, idx)
         return _kq.quat_multiply(q, _kso3.quat_from_rotvec(r))
     rdot = (3.0 * a * s + 2.0 * b) * s + c
     if order == 1:
         return _kso3.body_rate_from_rotvec_rate(r, rdot)
     return _kso3.body_acceleration_from_rotvec_rates(r, rdot, 6.0 * a * s + 2.0 * b)
+
+
+def _astype(x, like):
+    """``x`` with the dtype of ``like`` (one namespace)."""
+    if x.dtype == like.dtype:
+        return x
+    if hasattr(x, "to") and not hasattr(x, "astype"):  # torch
+        return x.to(like.dtype)
+    return x.astype(like.dtype)
 
 
 def bspline_basis(u):
@@ -306,11 +306,13 @@ def bspline_basis(u):
 
 
 def _bspline_setup(n, dt, t0, query, like):
-    xp = namespace_of(like)
-    x = (np.asarray(query, dtype=np.float64) - t0) / dt
-    seg = np.clip(np.floor(x).astype(np.intp), 0, n - 4)
-    u = _const(xp, x - seg, like)
-    return xp, seg, u
+    """Namespace, segment and position of each query; ``like`` met by the query."""
+    from .interpolation import meet, uniform_segment
+
+    query = meet(query, like)
+    like = meet(like, query)
+    seg, u = uniform_segment((query - t0) / dt, n - 3)
+    return like, seg, _astype(u, like)
 
 
 def bspline_so3_eval(quats, dt, t0, query, order):
@@ -330,9 +332,9 @@ def bspline_so3_eval(quats, dt, t0, query, order):
     array, shape (q, ..., 4) for order 0, else (q, ..., 3)
         Quaternions, body angular velocity (rad per time unit) or acceleration.
     """
-    xp, seg, u = _bspline_setup(quats.shape[0], dt, t0, query, quats)
+    quats, seg, u = _bspline_setup(quats.shape[0], dt, t0, query, quats)
     d_all = _relative_rotvecs(quats)
-    return _cumulative_eval(xp, quats, d_all, seg, u, dt, order, _SO3_OPS)
+    return _cumulative_eval(quats, d_all, seg, u, dt, order, _SO3_OPS)
 
 
 def bspline_se3_eval(poses, dt, t0, query, order):
@@ -341,12 +343,12 @@ def bspline_se3_eval(poses, dt, t0, query, order):
     As :func:`bspline_so3_eval` with poses ``(n, ..., 7)``; the rates are body
     twists ``(v, w)`` (``T^-1 dT/dt``) and their derivatives.
     """
-    xp, seg, u = _bspline_setup(poses.shape[0], dt, t0, query, poses)
+    poses, seg, u = _bspline_setup(poses.shape[0], dt, t0, query, poses)
     d_all = _kse3.twist_from_pose(_kse3.pose_compose(_kse3.pose_inv(poses[:-1]), poses[1:]))
-    return _cumulative_eval(xp, poses, d_all, seg, u, dt, order, _SE3_OPS)
+    return _cumulative_eval(poses, d_all, seg, u, dt, order, _SE3_OPS)
 
 
-def _cumulative_eval(xp, ctrl, d_all, seg, u, dt, order, ops):
+def _cumulative_eval(ctrl, d_all, seg, u, dt, order, ops):
     """The B-spline value or body rate of the module doc, on one group.
 
     ``ctrl`` are the control elements (n, ..., k), ``d_all`` their relative
@@ -358,11 +360,10 @@ def _cumulative_eval(xp, ctrl, d_all, seg, u, dt, order, ops):
     exp, compose, inverse_adjoint, apply_adjoint, bracket = ops
     u = _expand(u, ctrl.ndim - 2)
     l, dl, ddl = bspline_basis(u)
-    dev = device_of(ctrl)
-    x = _take(xp, ctrl, seg, dev)
+    x = ctrl[seg]
     w = dw = None
     for j in range(3):
-        d = _take(xp, d_all, seg + j, dev)
+        d = d_all[seg + j]
         a = exp(l[..., j : j + 1] * d)
         x = compose(x, a)
         if order == 0:

@@ -1,0 +1,151 @@
+"""Regression tests: functions that read values in Python broke jax.jit, Dask laziness
+and torch.compile (issue 22).
+
+Each test runs a call under the transform and compares it with the same call on
+NumPy (the reference: the eager NumPy path, itself tested against scipy and
+closed forms elsewhere), with value checks on and off (``rk.set_validation``).
+Dask calls must compute nothing (a callback counts graph executions) and give the
+NumPy result after ``.compute()``. The generated matrix (tests/backend_matrix/)
+covers every public callable; these are the failures found, small and fast.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import rigidkit as rk
+
+needs = pytest.mark.needs
+
+
+@pytest.fixture(params=[True, False], ids=["checks", "no-checks"])
+def validation(request):
+    with rk.set_validation(request.param):
+        yield request.param
+
+
+class _Computes:
+    """Counts Dask graph executions (``with _Computes() as c: ...; c.n``)."""
+
+    def __enter__(self):
+        from dask.callbacks import Callback
+
+        outer = self
+        self.n = 0
+
+        class Count(Callback):
+            def _start(self, dsk):
+                outer.n += 1
+
+        self._cb = Count()
+        self._cb.__enter__()
+        return self
+
+    def __exit__(self, *exc):
+        self._cb.__exit__(*exc)
+
+
+def lazily(dask_array, fn, *numpy_args, chunks=2):
+    """``fn`` on Dask versions of ``numpy_args``: (result, computes during the call)."""
+    args = [dask_array.from_array(a, chunks=chunks) for a in numpy_args]
+    with _Computes() as c:
+        out = fn(*args)
+    return out, c.n
+
+
+@pytest.fixture
+def keys():
+    rng = np.random.default_rng(7)
+    times = np.cumsum(rng.uniform(0.5, 1.5, 6))
+    rotations = rk.Rotation.random(6, rng)
+    transforms = rk.Transform.exp(rng.normal(size=(6, 6)))
+    return times, rotations, transforms
+
+
+def _interpolators(times, rotations, transforms):
+    """name -> (interpolator's call of query times, queries within its range)."""
+    span = times[-1] - times[0]
+    inside = times[0] + span * np.array([0.0, 0.13, 0.5, 0.77, 1.0])
+    bspline_t = 3.0 * np.array([0.0, 0.3, 0.5, 0.91, 1.0])
+    return {
+        "Slerp": (lambda q: rk.Slerp(times, rotations)(q).as_quat(), inside),
+        "Slerp-Transform": (lambda q: rk.Slerp(times, transforms)(q).as_matrix(), inside),
+        "RotationSpline": (
+            lambda q: rk.RotationSpline(times, rotations)(q).as_quat(),
+            inside,
+        ),
+        "RotationSpline-rate": (
+            lambda q: rk.RotationSpline(times, rotations)(q, 1, frame="world"),
+            inside,
+        ),
+        "RotationSpline-extrapolated": (
+            lambda q: rk.RotationSpline(times, rotations, extrapolate=True)(
+                q, 2, frame="body"
+            ),
+            inside + np.array([-1.0, 0.0, 0.0, 0.0, 1.0]),
+        ),
+        "BSplineSO3": (lambda q: rk.BSplineSO3(rotations)(q, 1, frame="body"), bspline_t),
+        "BSplineSE3": (lambda q: rk.BSplineSE3(transforms)(q).as_matrix(), bspline_t),
+    }
+
+
+INTERPOLATORS = [
+    "Slerp",
+    "Slerp-Transform",
+    "RotationSpline",
+    "RotationSpline-rate",
+    "RotationSpline-extrapolated",
+    "BSplineSO3",
+    "BSplineSE3",
+]
+
+
+@pytest.mark.parametrize(
+    "name, checks",
+    [(name, True) for name in INTERPOLATORS]
+    + [(name, False) for name in ("Slerp", "RotationSpline", "BSplineSO3")],
+)
+def test_interpolators_trace_under_jit(name, checks, keys, jax, jnp):
+    """Query times stay JAX arrays (they were turned into NumPy), checks on or off."""
+    fn, q = _interpolators(*keys)[name]
+    with rk.set_validation(checks):
+        out = jax.jit(fn)(jnp.asarray(q))
+    assert np.allclose(np.asarray(out), fn(q), rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("name", INTERPOLATORS)
+def test_interpolators_stay_lazy_on_dask(name, keys, dask_array):
+    """Dask query times give a Dask result and compute nothing during the call."""
+    fn, q = _interpolators(*keys)[name]
+    out, computes = lazily(dask_array, fn, q)
+    assert computes == 0
+    assert isinstance(out, dask_array.Array)
+    assert np.allclose(out.compute(), fn(q), rtol=0, atol=1e-12)
+
+
+def test_interpolation_range_checked_at_compute_time_on_dask(keys, dask_array):
+    times, rotations, _ = keys
+    q = np.array([times[0], times[-1] + 0.5, times[1]])
+    out, computes = lazily(dask_array, lambda t: rk.Slerp(times, rotations)(t).as_quat(), q)
+    assert computes == 0
+    with pytest.raises(rk.OutOfRangeError, match=r"at index \(1,\)"):
+        out.compute()
+
+
+def test_interpolators_on_torch_keep_the_graph(keys, torch):
+    """Torch query times: the result is a tensor, differentiable in the times."""
+    times, rotations, _ = keys
+    spline = rk.RotationSpline(times, rotations)
+    q = torch.tensor(
+        [times[0] + 0.3, times[2] + 0.1], dtype=torch.float64, requires_grad=True
+    )
+    rate = spline(q, 1, frame="body")
+    (g,) = torch.autograd.grad(rate.sum(), q)
+    eps = 1e-6
+    qn = q.detach().numpy()
+    fd = (spline(qn + eps, 1, frame="body") - spline(qn - eps, 1, frame="body")) / (2 * eps)
+    assert np.allclose(g.numpy(), fd.sum(axis=-1), atol=1e-6)
+    assert np.allclose(
+        spline(q.detach()).as_quat().numpy(), spline(qn).as_quat(), atol=1e-14
+    )
