@@ -1,0 +1,601 @@
+"""``rigidkit.scipy.Rotation`` and ``Slerp``: scipy's API, rigidkit's computations.
+
+Every method has the signature, defaults and semantics of
+``scipy.spatial.transform.Rotation`` (quaternions ``(x, y, z, w)`` unless
+``scalar_first=True``, ``*`` composes, ``apply`` rotates vectors); the work is done
+by :class:`rigidkit.Rotation`, which the wrapper holds (``as_rigidkit()``). Unlike
+rigidkit's own objects the wrapper is mutable where scipy's is (``r[i] = ...``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ...objects.rotation import Rotation as _RkRotation
+from ..alignment import align_vectors as _align_vectors
+from ..interpolation import Slerp as _RkSlerp
+from ._arrays import as_float, scalar
+
+__all__ = ["Rotation", "Slerp"]
+
+_wrap_rk = _RkRotation._wrap
+_from_quat_rk = _RkRotation.from_quat
+
+
+def _new(r):
+    """A wrapper around the rigidkit Rotation ``r`` (no copy, no checks)."""
+    obj = object.__new__(Rotation)
+    obj._r = r
+    return obj
+
+
+def _check_trail(x, trail, what):
+    shape = tuple(x.shape)
+    if shape[len(shape) - len(trail) :] != trail or len(shape) < len(trail):
+        text = ", ".join(str(t) for t in trail)
+        raise ValueError(f"Expected `{what}` to have shape (..., {text}), got {shape}.")
+
+
+def _shape_arg(num, shape):
+    if num is not None and shape is not None:
+        raise ValueError("Only one of `num` or `shape` can be specified.")
+    if shape is not None:
+        if isinstance(shape, (int, np.integer)):
+            return (int(shape),)
+        if not isinstance(shape, tuple) or not all(
+            isinstance(s, (int, np.integer)) for s in shape
+        ):
+            raise ValueError("`shape` must be an int or a tuple of ints.")
+        return shape
+    return () if num is None else (num,)
+
+
+def _rng(rng):
+    if isinstance(rng, (np.random.RandomState, np.random.Generator)):
+        return rng
+    return np.random.default_rng(rng)
+
+
+class Rotation:
+    """Rotations in 3 dimensions, with scipy's API (``scipy.spatial.transform.Rotation``).
+
+    A drop-in replacement: ``from rigidkit.scipy import Rotation``. Quaternions
+    are scalar last ``(x, y, z, w)`` unless ``scalar_first=True``; ``p * q``
+    applies ``q`` first; every computation is :class:`rigidkit.Rotation`'s
+    (``as_rigidkit()`` returns it). Works on NumPy (float64, as scipy), torch
+    and JAX arrays (the input's namespace and dtype kept).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from rigidkit.scipy import Rotation as R
+    >>> r = R.from_euler("z", 90, degrees=True)
+    >>> np.round(r.apply([1.0, 0.0, 0.0]), 12) + 0.0
+    array([0., 1., 0.])
+    >>> np.round(r.as_quat(), 12) + 0.0                  # (x, y, z, w)
+    array([0.        , 0.        , 0.70710678, 0.70710678])
+    >>> np.round((r * r).as_rotvec(), 12) + 0.0
+    array([0.        , 0.        , 3.14159265])
+    """
+
+    __slots__ = ("_r",)
+
+    def __init__(self, quat, normalize=True, copy=True, scalar_first=False):
+        q = as_float(quat)
+        _check_trail(q, (4,), "quat")
+        if normalize:
+            self._r = _from_quat_rk(q, scalar_first=scalar_first)
+        else:  # stored as given (rigidkit keeps (w, x, y, z): a copy when reordered)
+            self._r = _wrap_rk((q.copy() if copy else q) if scalar_first else _wxyz(q))
+
+    # -- construction ------------------------------------------------------------------
+    @staticmethod
+    def from_quat(quat, *, scalar_first=False):
+        """From quaternions, shape (..., 4), normalised; ``(x, y, z, w)`` unless
+        ``scalar_first=True``."""
+        q = as_float(quat)
+        if q.shape[-1:] != (4,):
+            _check_trail(q, (4,), "quat")
+        return _new(_from_quat_rk(q, scalar_first=scalar_first))
+
+    @staticmethod
+    def from_matrix(matrix, *, assume_valid=False):
+        """From matrices (..., 3, 3): the nearest rotation of any matrix of positive
+        determinant (scipy's projection); ``assume_valid=True`` skips it."""
+        m = as_float(matrix)
+        if tuple(m.shape[-2:]) != (3, 3) or m.ndim < 2:
+            raise ValueError(
+                f"Expected `matrix` to have shape (..., 3, 3), got {tuple(m.shape)}"
+            )
+        if assume_valid:
+            return _new(_RkRotation.from_matrix(m, atol=math.inf))
+        det = _det3(m)
+        if bool((det <= 0).any()):
+            raise ValueError(
+                "Non-positive determinant (left-handed or null coordinate frame) in "
+                "rotation matrix."
+            )
+        return _new(_RkRotation.from_matrix(m, orthonormalize=True))
+
+    @staticmethod
+    def from_rotvec(rotvec, degrees=False):
+        """From rotation vectors ``angle * axis``, shape (..., 3)."""
+        r = as_float(rotvec)
+        if r.shape[-1:] != (3,):
+            raise ValueError(
+                f"Expected `rot_vec` to have shape (3,) or (N, 3), got {tuple(r.shape)}"
+            )
+        return _new(_RkRotation.from_rotvec(r, degrees=degrees))
+
+    @staticmethod
+    def from_mrp(mrp):
+        """From modified Rodrigues parameters, shape (..., 3)."""
+        p = as_float(mrp)
+        if p.shape[-1:] != (3,):
+            raise ValueError(
+                f"Expected `mrp` to have shape (3,) or (N, 3), got {tuple(p.shape)}"
+            )
+        return _new(_RkRotation.from_mrp(p))
+
+    @staticmethod
+    def from_euler(seq, angles, degrees=False):
+        """From Euler angles: ``seq`` of 1 to 3 axes, UPPER intrinsic, lower extrinsic."""
+        return _new(_RkRotation.from_euler(seq, as_float(angles), degrees=degrees))
+
+    @staticmethod
+    def from_davenport(axes, order, angles, degrees=False):
+        """From Davenport angles about 1 to 3 axes (``order`` "e" or "i")."""
+        return _new(
+            _RkRotation.from_davenport(
+                as_float(axes), order, as_float(angles), degrees=degrees
+            )
+        )
+
+    @staticmethod
+    def identity(num=None, *, shape=None):
+        """The identity rotation: single, ``num`` of them, or batch ``shape``."""
+        return _new(_RkRotation.identity(_shape_arg(num, shape)))
+
+    @staticmethod
+    def random(num=None, rng=None, *, shape=None):
+        """Uniformly distributed rotations (normalised 4-D Gaussian samples, drawn as
+        scipy draws them: the same ``rng`` gives the same rotations)."""
+        shp = _shape_arg(num, shape)
+        sample = _rng(rng).normal(size=shp + (4,))
+        return _new(_from_quat_rk(sample, scalar_first=False))
+
+    @staticmethod
+    def create_group(group, axis="Z"):
+        """The rotations of a finite symmetry group (``"I"``, ``"O"``, ``"T"``,
+        ``"Dn"``, ``"Cn"``)."""
+        return _new(_RkRotation.create_group(group, axis))
+
+    @staticmethod
+    def concatenate(rotations):
+        """Join rotations (single ones or 1-D stacks) into one stack."""
+        if isinstance(rotations, Rotation):
+            return _new(rotations._r)
+        rotations = list(rotations)
+        if not all(isinstance(x, Rotation) for x in rotations):
+            raise TypeError("input must contain Rotation objects only")
+        return _new(_RkRotation.concatenate([x._r for x in rotations]))
+
+    @staticmethod
+    def align_vectors(a, b, weights=None, return_sensitivity=False):
+        """The rotation best aligning ``b`` to ``a`` (Wahba), with scipy's returns:
+        ``(rotation, rssd)`` or ``(rotation, rssd, sensitivity)``."""
+        a_in, b_in = as_float(a), as_float(b)
+        a2 = a_in[None] if a_in.ndim == 1 else a_in
+        b2 = b_in[None] if b_in.ndim == 1 else b_in
+        if a2.shape[-1] != 3:
+            raise ValueError(
+                f"Expected input `a` to have shape (3,) or (N, 3), got {tuple(a_in.shape)}"
+            )
+        if b2.shape[-1] != 3:
+            raise ValueError(
+                f"Expected input `b` to have shape (3,) or (N, 3), got {tuple(b_in.shape)}"
+            )
+        if a2.shape != b2.shape:
+            raise ValueError(
+                "Expected inputs `a` and `b` to have same shapes, got "
+                f"{tuple(a_in.shape)} and {tuple(b_in.shape)} respectively."
+            )
+        if a2.ndim > 2:
+            raise ValueError(
+                "Expected inputs `a` and `b` to have shape (3,) or (N, 3), got "
+                f"{tuple(a_in.shape)} and {tuple(b_in.shape)} respectively."
+            )
+        n = a2.shape[0]
+        if weights is not None:
+            w = as_float(weights)
+            if w.ndim != 1:
+                raise ValueError(
+                    f"Expected `weights` to be 1 dimensional, got shape {tuple(w.shape)}."
+                )
+            if n > 1 and w.shape[0] != n:
+                raise ValueError(
+                    "Expected `weights` to have number of values equal to number of "
+                    f"input vectors, got {w.shape[0]} values and {n} vectors."
+                )
+            if bool((w < 0).any()):
+                raise ValueError("`weights` may not contain negative values")
+            n_inf = int((w == math.inf).sum())
+            if n_inf > 1:
+                raise ValueError("Only one infinite weight is allowed")
+            if n_inf == 1 or n == 1:
+                weights = w = (w * 0 + math.inf) if n == 1 else w
+                _primary_nonzero(a2, b2, w)
+        elif n == 1:
+            _primary_nonzero(a2, b2, None)
+        if return_sensitivity and (
+            n == 1 or (weights is not None and bool((w == math.inf).any()))
+        ):
+            raise ValueError(
+                "Cannot return sensitivity matrix with an infinite weight or one "
+                "vector pair"
+            )
+        out = _align_vectors(a2, b2, weights, return_sensitivity=return_sensitivity)
+        result = (_new(out[0]), scalar(out[1]))
+        return result + ((out[2],) if return_sensitivity else ())
+
+    # -- representations ---------------------------------------------------------------
+    def as_quat(self, canonical=False, *, scalar_first=False):
+        """Quaternions (..., 4), ``(x, y, z, w)`` unless ``scalar_first=True``;
+        ``canonical=True`` gives ``w >= 0`` (scipy's tie-breaking)."""
+        q = self._r._quat
+        if canonical:
+            q = _canonical(q)
+        if scalar_first:
+            return q.copy() if hasattr(q, "copy") else q.clone()
+        return _xyzw(q)
+
+    def as_matrix(self):
+        """Rotation matrices, shape (..., 3, 3)."""
+        return self._r.as_matrix()
+
+    def as_rotvec(self, degrees=False):
+        """Rotation vectors, angle in [0, pi], shape (..., 3)."""
+        return self._r.as_rotvec(degrees=degrees)
+
+    def as_mrp(self):
+        """Modified Rodrigues parameters, norm <= 1, shape (..., 3)."""
+        return self._r.as_mrp()
+
+    def as_euler(self, seq, degrees=False, *, suppress_warnings=False):
+        """Euler angles for a 3-axis ``seq``, shape (..., 3); a gimbal lock warns
+        (a :class:`~rigidkit.GimbalLockWarning`, a ``UserWarning``) unless
+        ``suppress_warnings=True``."""
+        if suppress_warnings:
+            return _quiet(self._r.as_euler, seq, degrees=degrees)
+        return self._r.as_euler(seq, degrees=degrees)
+
+    def as_davenport(self, axes, order, degrees=False, *, suppress_warnings=False):
+        """Davenport angles about three axes, shape (..., 3)."""
+        axes = as_float(axes)
+        if suppress_warnings:
+            return _quiet(self._r.as_davenport, axes, order, degrees=degrees)
+        return self._r.as_davenport(axes, order, degrees=degrees)
+
+    def as_rigidkit(self):
+        """The :class:`rigidkit.Rotation` holding these rotations (immutable)."""
+        return self._r
+
+    @staticmethod
+    def from_rigidkit(rotation):
+        """A wrapper of the :class:`rigidkit.Rotation` ``rotation``."""
+        if not isinstance(rotation, _RkRotation):
+            raise TypeError(f"expected a rigidkit.Rotation, got {type(rotation).__name__}")
+        return _new(rotation)
+
+    # -- operations --------------------------------------------------------------------
+    def apply(self, vectors, inverse=False):
+        """Rotate vectors (..., 3), broadcasting with the rotations' shape."""
+        v = as_float(vectors)
+        if v.shape[-1:] != (3,):
+            raise ValueError(f"Expected input of shape (..., 3), got {tuple(v.shape)}.")
+        shape = self._r._quat.shape[:-1]
+        if shape and v.ndim > 1:
+            _broadcast(shape, tuple(v.shape[:-1]))
+        return self._r.apply(v, inverse=inverse)
+
+    def __mul__(self, other):
+        if not isinstance(other, Rotation):
+            return NotImplemented
+        a, b = self._r, other._r
+        sa, sb = a._quat.shape[:-1], b._quat.shape[:-1]
+        if sa != sb and sa and sb:
+            _broadcast(sa, sb, "rotations")
+        return _new(a @ b)
+
+    def __pow__(self, n, modulus=None):
+        if modulus is not None:
+            raise NotImplementedError("modulus not supported")
+        return _new(self._r**n)
+
+    def inv(self):
+        """The inverse rotations."""
+        return _new(self._r.inv())
+
+    def magnitude(self):
+        """Rotation angles in [0, pi], shape (...) (a NumPy scalar for one)."""
+        return scalar(self._r.magnitude())
+
+    def approx_equal(self, other, atol=None, degrees=False):
+        """Whether the angle between the rotations is at most ``atol`` (1e-8 rad if
+        None; degrees with ``degrees=True``)."""
+        if atol is None:
+            if degrees:
+                import warnings
+
+                warnings.warn(
+                    "atol must be set to use the degrees flag, defaulting to 1e-8 radians.",
+                    stacklevel=2,
+                )
+            atol = 1e-8
+        elif degrees:
+            atol = math.radians(atol)
+        sa, sb = self._r._quat.shape[:-1], other._r._quat.shape[:-1]
+        if sa != sb and sa and sb:
+            _broadcast(sa, sb, "rotations")
+        return self._r.angle_to(other._r) <= atol
+
+    def mean(self, weights=None, axis=None):
+        """The chordal mean rotation (scipy's), along ``axis`` (default all)."""
+        if axis is not None and not isinstance(axis, (int, np.integer, tuple)):
+            raise ValueError("`axis` must be None, int, or tuple of ints.")
+        shape = self.shape
+        if math.prod(shape) == 0 or self.single and False:
+            raise ValueError("Mean of an empty rotation set is undefined.")
+        nd = len(shape)
+        axes = (
+            tuple(range(nd))
+            if axis is None
+            else (axis if isinstance(axis, tuple) else (axis,))
+        )
+        for ax in axes:
+            if not -max(nd, 1) <= ax < max(nd, 1):
+                raise ValueError(
+                    f"axis {ax} is out of bounds for rotations of {nd} dimensions"
+                )
+        r = self._r if nd else self._r.reshape(1)
+        if weights is not None:
+            w = as_float(weights)
+            if nd == 0 and w.ndim == 0:
+                w = w[None]
+            try:
+                np.broadcast_shapes(tuple(w.shape), r.shape)
+            except ValueError:
+                raise ValueError(
+                    "Expected `weights` to be broadcastable to the rotation shape "
+                    f"{r.shape}, got {tuple(w.shape)}."
+                ) from None
+            if bool((w < 0).any()):
+                raise ValueError("`weights` must be non-negative.")
+            weights = w
+        return _new(r.mean(weights, axis=axis))
+
+    def reduce(self, left=None, right=None, return_indices=False):
+        """``l * self * r`` of smallest angle over ``l`` in ``left``, ``r`` in
+        ``right``; with ``return_indices`` also their indices."""
+        out = self._r.reduce(
+            None if left is None else left._r,
+            None if right is None else right._r,
+            return_indices=return_indices,
+        )
+        if return_indices:
+            return (_new(out[0]),) + tuple(out[1:])
+        return _new(out)
+
+    # -- container protocol ------------------------------------------------------------
+    @property
+    def single(self):
+        """Whether this holds one rotation (batch shape ``()``)."""
+        return self._r._quat.ndim == 1
+
+    @property
+    def shape(self):
+        """The batch shape."""
+        return tuple(self._r._quat.shape[:-1])
+
+    def __len__(self):
+        if self._r._quat.ndim == 1:
+            raise TypeError("Single rotation has no len().")
+        return self._r._quat.shape[0]
+
+    def __bool__(self):
+        return True
+
+    def __getitem__(self, indexer):
+        q = self._r._quat
+        if q.ndim == 1:
+            raise TypeError("Single rotation is not subscriptable.")
+        if isinstance(indexer, tuple) or indexer is Ellipsis:
+            idx = (indexer if isinstance(indexer, tuple) else (indexer,)) + (slice(None),)
+            if Ellipsis not in [i for i in idx if i is Ellipsis]:
+                idx = tuple(idx[:-1]) + (Ellipsis, slice(None))
+            out = q[idx]
+        else:
+            if isinstance(indexer, list):
+                indexer = np.asarray(indexer)
+            out = q[indexer]
+        return _new(_wrap_rk(out))
+
+    def __setitem__(self, indexer, value):
+        if self._r._quat.ndim == 1:
+            raise TypeError("Single rotation is not subscriptable.")
+        if not isinstance(value, Rotation):
+            raise TypeError("value must be a Rotation object")
+        q = self._r._quat
+        q = (
+            np.array(q)
+            if type(q) is np.ndarray
+            else q.clone()
+            if hasattr(q, "clone")
+            else q
+        )
+        if hasattr(q, "at") and not hasattr(q, "clone") and type(q) is not np.ndarray:
+            q = q.at[indexer].set(value._r._quat)
+        else:
+            q[indexer] = value._r._quat
+        self._r = _wrap_rk(q)
+
+    def __iter__(self):
+        if self._r._quat.ndim == 1:
+            raise TypeError("Single rotation is not iterable.")
+        for k in range(len(self)):
+            yield self[k]
+
+    def __repr__(self):
+        m = f"{self.as_matrix()!r}".splitlines()
+        # scipy's: the matrix repr indented under ``Rotation.from_matrix(``.
+        return (
+            "Rotation.from_matrix("
+            + "\n".join([m[0]] + [" " * 21 + line for line in m[1:]])
+            + ")"
+        )
+
+    def __reduce__(self):
+        return (_unpickle, (self.as_quat(scalar_first=True),))
+
+    def __getstate__(self):
+        return self.as_quat(scalar_first=True), self.single
+
+    def __setstate__(self, state):
+        self._r = _wrap_rk(state[0])
+
+
+def _unpickle(quat):
+    return _new(_wrap_rk(quat))
+
+
+def _wxyz(q):
+    if type(q) is np.ndarray:
+        return np.concatenate([q[..., 3:], q[..., :3]], axis=-1)
+    return _cat(q[..., 3:], q[..., :3])
+
+
+def _xyzw(q):
+    if type(q) is np.ndarray:
+        out = np.empty_like(q)
+        out[..., :3] = q[..., 1:]
+        out[..., 3] = q[..., 0]
+        return out
+    return _cat(q[..., 1:], q[..., :1])
+
+
+def _cat(a, b):
+    from ..._engine.namespace import namespace_of
+
+    return namespace_of(a).concat([a, b], axis=-1)
+
+
+def _canonical(q):
+    """``q`` or ``-q``: scipy's canonical sign (w > 0, ties broken by x, y, z)."""
+    from ..._engine.namespace import namespace_of
+
+    xp = namespace_of(q)
+    w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    flip = (w < 0) | ((w == 0) & ((x < 0) | ((x == 0) & ((y < 0) | ((y == 0) & (z < 0))))))
+    return xp.where(flip[..., None], -q, q)
+
+
+def _det3(m):
+    a, b, c = m[..., 0, :], m[..., 1, :], m[..., 2, :]
+    return (
+        a[..., 0] * (b[..., 1] * c[..., 2] - b[..., 2] * c[..., 1])
+        - a[..., 1] * (b[..., 0] * c[..., 2] - b[..., 2] * c[..., 0])
+        + a[..., 2] * (b[..., 0] * c[..., 1] - b[..., 1] * c[..., 0])
+    )
+
+
+def _broadcast(sa, sb, what=None):
+    try:
+        return np.broadcast_shapes(tuple(sa), tuple(sb))
+    except ValueError:
+        if what is None:
+            raise ValueError(
+                f"Cannot broadcast {tuple(sa)} rotations to {tuple(sb)} vectors "
+                "(operands could not be broadcast together)."
+            ) from None
+        raise ValueError(
+            f"Cannot broadcast {tuple(sa)} {what} in first to {tuple(sb)} {what} in "
+            "second object."
+        ) from None
+
+
+def _primary_nonzero(a, b, w):
+    k = 0 if w is None else int(np.argmax(np.asarray(w) == math.inf))
+    if not (bool((a[k] ** 2).sum() > 0) and bool((b[k] ** 2).sum() > 0)):
+        raise ValueError("Cannot align zero length primary vectors")
+
+
+def _quiet(fn, *args, **kwargs):
+    import warnings
+
+    from ...errors import GimbalLockWarning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", GimbalLockWarning)
+        return fn(*args, **kwargs)
+
+
+class Slerp:
+    """Spherical linear interpolation of rotations (scipy's ``Slerp``).
+
+    Parameters
+    ----------
+    times : array_like, shape (N,)
+        Strictly increasing times of the keyframes, ``N >= 2``.
+    rotations : Rotation, shape (N,)
+        The keyframes.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from rigidkit.scipy import Rotation, Slerp
+    >>> keys = Rotation.from_rotvec([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    >>> np.round(Slerp([0.0, 2.0], keys)(0.5).as_rotvec(), 12) + 0.0
+    array([0.  , 0.  , 0.25])
+    """
+
+    def __init__(self, times, rotations):
+        if not isinstance(rotations, Rotation):
+            raise TypeError("`rotations` must be a `Rotation` instance.")
+        if rotations.single or len(rotations) <= 1:
+            raise ValueError("`rotations` must be a sequence of at least 2 rotations.")
+        if len(rotations.shape) > 1:
+            raise ValueError(
+                "Rotations with more than 1 leading dimension are not supported."
+            )
+        t = as_float(times)
+        if t.ndim != 1:
+            raise ValueError(
+                "Expected times to be specified in a 1 dimensional array, got "
+                f"{t.ndim} dimensions."
+            )
+        if t.shape[0] != len(rotations):
+            raise ValueError(
+                "Expected number of rotations to be equal to number of timestamps "
+                f"given, got {len(rotations)} rotations and {t.shape[0]} timestamps."
+            )
+        if bool((t[1:] - t[:-1] <= 0).any()):
+            raise ValueError("Times must be in strictly increasing order.")
+        self.times = t
+        self.timedelta = t[1:] - t[:-1]
+        self.rotations = rotations[:-1]
+        self._slerp = _RkSlerp(t, rotations._r)
+
+    def __call__(self, times):
+        """The interpolated rotations at ``times`` (scalar or 1-D)."""
+        t = as_float(times)
+        if t.ndim > 1:
+            raise ValueError("`times` must be at most 1-dimensional.")
+        lo, hi = self.times[0], self.times[-1]
+        if bool(((t < lo) | (t > hi)).any()):
+            raise ValueError(
+                f"Interpolation times must be within the range [{lo}, {hi}], both "
+                "inclusive."
+            )
+        return _new(self._slerp(t))
