@@ -204,7 +204,7 @@ def warn_if_locked(s, angles, scale: float) -> None:
     lock = "0 or pi" if s.proper else "+-pi/2"
     first = batch_index(near)
     message = (
-        f"gimbal lock in {s.text!r}: {int(near.sum())} of {max(near.size, 1)} middle "
+        f"Gimbal lock in {s.text!r}: {int(near.sum())} of {max(near.size, 1)} middle "
         f"angles are within {tol / scale:.2g} rad of {lock} (first "
         f"{where_text(first)}); there only the sum or difference of the "
         f"first and third angle is well determined. The angles returned rebuild the "
