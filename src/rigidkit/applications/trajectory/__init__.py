@@ -11,6 +11,7 @@ from .align import align
 from .associate import associate
 from .kitti import KittiResult, kitti_errors
 from .metrics import MetricResult, ape, rpe, statistics
+from .pairs import pair_indices
 from .plot import plot, plot_error_colored, plot_errors, save_report
 from .trajectory import Trajectory
 
@@ -22,6 +23,7 @@ __all__ = [
     "ape",
     "associate",
     "kitti_errors",
+    "pair_indices",
     "plot",
     "plot_error_colored",
     "plot_errors",

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..._engine.namespace import namespace_of
+from ..._validate import raise_unless
 from ...errors import DegenerateInputError
 from ...objects.rotation import Rotation
 from ...objects.similarity import Similarity
@@ -25,19 +27,21 @@ def _yaw_fit(src, dst):
     Scaramuzza 2018, Sec. IV, for visual-inertial odometry, where gravity makes
     roll and pitch observable). Batched over the leading axes.
     """
-    ms, md = src.mean(axis=-2), dst.mean(axis=-2)
+    xp = namespace_of(src, dst)
+    n = src.shape[-2]
+    ms, md = xp.sum(src, axis=-2) / n, xp.sum(dst, axis=-2) / n
     a, b = src - ms[..., None, :], dst - md[..., None, :]
-    sin = (a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]).sum(axis=-1)
-    cos = (a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1]).sum(axis=-1)
-    if np.any((sin == 0.0) & (cos == 0.0)):
-        raise DegenerateInputError(
-            "yaw alignment: the positions do not move in the x-y plane, so no yaw "
-            "can be fitted"
-        )
-    psi = np.arctan2(sin, cos)
-    rotvec = np.zeros(psi.shape + (3,))
-    rotvec[..., 2] = psi
-    R = Rotation.from_rotvec(rotvec)
+    sin = xp.sum(a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0], axis=-1)
+    cos = xp.sum(a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1], axis=-1)
+    raise_unless(
+        (sin != 0.0) | (cos != 0.0),
+        DegenerateInputError,
+        "yaw alignment: the positions do not move in the x-y plane, so no yaw "
+        "can be fitted",
+    )
+    psi = xp.atan2(sin, cos)
+    zero = xp.zeros_like(psi)
+    R = Rotation.from_rotvec(xp.stack([zero, zero, psi], axis=-1))
     return Transform(rotation=R, translation=md - R.apply(ms))
 
 
@@ -106,10 +110,15 @@ def align(est, ref, method="se3", first=None):
     if method == "origin":
         S = ref.poses[..., 0] @ est.poses[..., 0].inv()
         return est.transform(S), S
-    src = np.asarray(est.positions)[..., :n, :]
-    dst = np.asarray(ref.positions)[..., :n, :]
+    # The positions of the poses' namespace: on torch and JAX the fit, and the
+    # transform it applies, are differentiable (the SVD of Umeyama's method, for
+    # distinct singular values).
+    src = est.positions[..., :n, :]
+    dst = ref.positions[..., :n, :]
     if method == "yaw":
-        S = _yaw_fit(*np.broadcast_arrays(src, dst))
+        shape = np.broadcast_shapes(src.shape, dst.shape)
+        xp = namespace_of(src, dst)
+        S = _yaw_fit(xp.broadcast_to(src, shape), xp.broadcast_to(dst, shape))
     else:
         S = align_points(src, dst, scale=method != "se3")
         if method == "scale":

@@ -21,16 +21,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..._validate import to_numpy
-from ...errors import ShapeError
+from ..._engine import dask_backend
+from ..._engine.namespace import is_numpy, namespace_of
+from ..._validate import concrete, to_numpy
+from ...errors import RigidkitError, ShapeError
 from ...objects.registry import stored
 from ...objects.transform import Transform
+from . import _array_metrics
+from .pairs import UNITS, pair_indices
 from .trajectory import Trajectory, check_pair
 
 __all__ = ["RELATIONS", "UNITS", "MetricResult", "ape", "pair_indices", "rpe", "statistics"]
 
 RELATIONS = ("translation", "rotation_angle", "rotation_part", "full", "point_distance")
-UNITS = ("frames", "meters", "degrees", "radians")
 _SQRT8 = np.sqrt(8.0)
 
 
@@ -99,20 +102,23 @@ class MetricResult:
 
     Attributes
     ----------
-    errors : ndarray, shape (..., M)
-        One error per pose (APE) or pair (RPE).
+    errors : array, shape (..., M)
+        One error per pose (APE) or pair (RPE): NumPy float64 for NumPy poses,
+        else an array of the poses' namespace (torch, JAX), on their graph.
     stamps : ndarray, shape (M,), or None
         The reference stamp of each pose (APE), of each pair's first pose (RPE).
     pairs : ndarray of int, shape (M, 2), or None
         RPE: the index pairs ``(i, j)`` compared; ``None`` for APE.
     stats : dict
-        ``rmse, mean, median, std, min, max, sse`` (see :func:`statistics`).
+        ``rmse, mean, median, std, min, max, sse`` (see :func:`statistics`):
+        floats for one NumPy trajectory pair, else arrays (of the poses'
+        namespace, differentiable, for torch and JAX poses).
     relation, unit : str
         What the numbers are: the relation, and ``"m"``, ``"rad"``, ``"deg"`` or
         ``"unit-less"``.
     """
 
-    errors: np.ndarray
+    errors: object
     stamps: np.ndarray | None
     pairs: np.ndarray | None
     stats: dict
@@ -121,7 +127,9 @@ class MetricResult:
 
     def __repr__(self):
         s = self.stats
-        body = ", ".join(f"{k}={s[k]:.6g}" for k in ("rmse", "mean", "max"))
+        body = ", ".join(
+            f"{k}={float(to_numpy(s[k])):.6g}" for k in ("rmse", "mean", "max")
+        )
         kind = "RPE" if self.pairs is not None else "APE"
         return f"<{kind} {self.relation} [{self.unit}]: n={self.errors.shape[-1]}, {body}>"
 
@@ -134,13 +142,37 @@ def _check(relation, ref, est):
     check_pair(("ref", ref), ("est", est), "compare")
 
 
+def _namespace(ref, est):
+    """The poses' namespace where the metrics compute in it (torch, JAX, ...);
+    None for NumPy and Dask, computed in NumPy on the host."""
+    a, b = stored(ref.poses), stored(est.poses)
+    if dask_backend.any_dask(a, b):
+        return None
+    xp = namespace_of(a, b)
+    return None if is_numpy(xp) else xp
+
+
 def _on_numpy(traj):
-    """``traj`` with its poses as NumPy float64 (off torch's graph and device):
-    the metrics are evaluation, computed in NumPy on the host."""
+    """``traj`` with its poses as NumPy float64 (off torch's graph and device)."""
     if isinstance(stored(traj.poses), np.ndarray):  # the stored array, not a copy
         return traj
     pq = np.asarray(to_numpy(traj.poses.as_pq()), dtype=np.float64)
     return Trajectory._trusted(traj.stamps, Transform.from_pq(pq))
+
+
+def _checked_pairs(pairs, n):
+    """``pairs`` as NumPy indices of shape (M, 2), each in ``[0, n)``."""
+    p = np.asarray(to_numpy(pairs))
+    if p.ndim != 2 or p.shape[1] != 2 or p.dtype.kind not in "iu":
+        raise ShapeError(f"pairs must be integers of shape (M, 2), got {p.dtype} {p.shape}")
+    bad = (p < 0) | (p >= n)
+    if bad.any():
+        k = int(np.argmax(bad.any(axis=1)))
+        raise ShapeError(
+            f"pairs[{k}] = {p[k].tolist()} is not a pair of indices in [0, {n})",
+            index=(k,),
+        )
+    return p
 
 
 def _unit(relation, degrees):
@@ -236,10 +268,11 @@ def ape(ref, est, relation="translation", degrees=False):
 
     Notes
     -----
-    Computed in NumPy: poses on torch or JAX are copied to NumPy float64 (off
-    the autograd graph and the device) and the result holds NumPy arrays. An
-    evaluation metric, like evo's; to differentiate a pose error, write it with
-    the poses' own operations (``est.poses.inv() @ ref.poses``).
+    Poses on torch or JAX are compared with their own namespace's operations:
+    ``errors`` and ``stats`` are arrays of it, so torch's autograd and
+    ``jax.grad`` differentiate them with respect to the poses, and the whole
+    function can be traced by ``jax.jit`` (the stamps, NumPy, are constants). At
+    an error of exactly zero the gradient of its norm is the subgradient 0.
 
     Examples
     --------
@@ -254,6 +287,13 @@ def ape(ref, est, relation="translation", degrees=False):
     0.353553390593
     """
     _check(relation, ref, est)
+    xp = _namespace(ref, est)
+    if xp is not None:
+        errors = _array_metrics.ape_errors(xp, ref, est, relation, degrees)
+        stats = _array_metrics.statistics(xp, errors)
+        return MetricResult(
+            errors, ref.stamps, None, stats, relation, _unit(relation, degrees)
+        )
     ref, est = _on_numpy(ref), _on_numpy(est)
     # E = est^-1 ref: R_E = R_est^T R_ref, and |t_E| = |R_est^T (p_ref - p_est)| =
     # |p_ref - p_est|, which is also the point distance: no pose product.
@@ -271,121 +311,6 @@ def ape(ref, est, relation="translation", degrees=False):
     )
 
 
-def _angles_to_next(poses):
-    """The rotation angle between consecutive poses, shape (N - 1,).
-
-    ``2 acos|a.b|`` loses precision near 0; with ``s = sign(a.b)`` (1 at 0), the
-    same angle is ``4 atan2(|a - s b|, |a + s b|)`` (the half-angle between the
-    unit quaternions on the 3-sphere), accurate everywhere.
-    """
-    q = np.asarray(poses.rotation.as_quat())
-    a, b = q[:-1], q[1:]
-    s = np.where(np.einsum("ij,ij->i", a, b) < 0.0, -1.0, 1.0)[:, None]
-    return 4.0 * np.arctan2(
-        np.linalg.norm(a - s * b, axis=-1), np.linalg.norm(a + s * b, axis=-1)
-    )
-
-
-def _walk(cumulative, delta):
-    """Indices chosen by walking: from each chosen index, the first later one whose
-    accumulated amount reaches ``delta``; one searchsorted per chosen index."""
-    chosen = [0]
-    n = len(cumulative)
-    i = 0
-    while True:
-        j = int(np.searchsorted(cumulative, cumulative[i] + delta, side="left"))
-        # cumulative[i] + delta rounds: confirm with the difference itself.
-        while j < n and cumulative[j] - cumulative[i] < delta:
-            j += 1
-        while j - 1 > i and cumulative[j - 1] - cumulative[i] >= delta:
-            j -= 1
-        if j >= n:
-            return np.asarray(chosen, dtype=np.intp)
-        chosen.append(j)
-        i = j
-
-
-def pair_indices(poses, delta, unit="frames", all_pairs=False, tolerance=0.1):
-    """The index pairs ``(i, j)`` that :func:`rpe` compares, shape (M, 2).
-
-    Chosen on ``poses`` (a Transform of shape (N,)) as evo chooses them:
-
-    - ``"frames"``: ``(0, d), (d, 2d), ...`` (``d = delta``, an integer); with
-      ``all_pairs``, every ``(i, i + d)``.
-    - ``"meters"``: walking along the path from the last chosen index, the
-      first index whose travelled distance from it reaches ``delta``, each chosen
-      index paired with the next; with ``all_pairs``, for every ``i`` the later
-      ``j`` whose travelled distance from ``i`` is closest to ``delta`` (the
-      earlier of two), kept if it differs from ``delta`` by at most
-      ``tolerance * delta``.
-    - ``"degrees"``/``"radians"``: as ``"meters"`` with the rotation angles
-      between consecutive poses accumulated; with ``all_pairs``, every pair
-      ``i < j`` whose direct rotation angle differs from ``delta`` by at most
-      ``tolerance * delta`` (an O(N^2) search, in blocks).
-    """
-    n = poses.shape[-1]
-    if unit not in UNITS:
-        raise ValueError(f"unit must be one of {', '.join(UNITS)}; got {unit!r}")
-    if unit == "frames":
-        d = int(delta)
-        if d != delta or d < 1:
-            raise ValueError(f"delta in frames must be a whole number >= 1, got {delta!r}")
-        if all_pairs:
-            i = np.arange(max(n - d, 0))
-            return np.stack([i, i + d], axis=-1)
-        ids = np.arange(0, n, d)
-        return np.stack([ids[:-1], ids[1:]], axis=-1)
-    delta = float(delta)
-    if not delta > 0:
-        raise ValueError(f"delta must be positive, got {delta!r}")
-    if unit == "meters":
-        p = np.asarray(poses.translation)
-        steps = np.linalg.norm(np.diff(p, axis=0), axis=-1)
-    else:
-        if unit == "degrees":
-            delta = np.radians(delta)
-        if all_pairs:
-            return _angle_pairs(poses, delta, tolerance * delta)
-        steps = _angles_to_next(poses)
-    cumulative = np.concatenate([[0.0], np.cumsum(steps)])
-    if not all_pairs:
-        ids = _walk(cumulative, delta) if n else np.zeros(0, dtype=np.intp)
-        return np.stack([ids[:-1], ids[1:]], axis=-1)
-    # For each i, the j > i with cumulative[j] - cumulative[i] closest to delta:
-    # the two neighbours of the target value.
-    i = np.arange(n)
-    hi = np.minimum(np.searchsorted(cumulative, cumulative + delta, side="left"), n - 1)
-    # The candidate below the target: the first index holding its value (a pose
-    # repeated by association adds a step of zero; the earliest index wins ties).
-    lo = np.searchsorted(cumulative, cumulative[np.maximum(hi - 1, 0)], side="left")
-    lo = np.minimum(np.maximum(lo, i + 1), n - 1)
-    hi = np.maximum(hi, lo)
-    gap_lo = np.abs(cumulative[lo] - cumulative - delta)
-    gap_hi = np.abs(cumulative[hi] - cumulative - delta)
-    j = np.where(gap_hi < gap_lo, hi, lo)
-    gap = np.minimum(gap_lo, gap_hi)
-    keep = (i + 1 < n) & (gap <= tolerance * delta)
-    return np.stack([i[keep], j[keep]], axis=-1)
-
-
-def _angle_pairs(poses, delta, tol, block=1024):
-    q = np.asarray(poses.rotation.as_quat())
-    n = len(q)
-    out_i, out_j = [], []
-    for start in range(0, n, block):
-        a = q[start : start + block]
-        dot = np.abs(a @ q.T)
-        angle = 2.0 * np.arccos(np.minimum(dot, 1.0))
-        rows = np.arange(start, start + len(a))[:, None]
-        ok = (np.abs(angle - delta) <= tol) & (np.arange(n)[None, :] > rows)
-        ii, jj = np.nonzero(ok)
-        out_i.append(ii + start)
-        out_j.append(jj)
-    if not out_i:
-        return np.zeros((0, 2), dtype=np.intp)
-    return np.stack([np.concatenate(out_i), np.concatenate(out_j)], axis=-1)
-
-
 def rpe(
     ref,
     est,
@@ -396,6 +321,7 @@ def rpe(
     tolerance=0.1,
     degrees=False,
     pairs_from="estimate",
+    pairs=None,
 ):
     """Relative pose error of pose pairs: ``E_ij = (ref_i^-1 ref_j)^-1 (est_i^-1 est_j)``.
 
@@ -419,6 +345,12 @@ def rpe(
         ``"rotation_angle"`` in degrees.
     pairs_from : {"estimate", "reference"}
         The trajectory whose path chooses the pairs (evo's default: the estimate).
+    pairs : array_like of int, shape (M, 2), optional
+        The index pairs ``(i, j)`` to compare, chosen beforehand (by
+        :func:`pair_indices`, say): ``delta``, ``unit``, ``all_pairs``,
+        ``tolerance`` and ``pairs_from`` are then not used. For gradients with
+        ``jax.grad`` or ``jax.jit`` and pairs in a metric unit, which need the
+        poses' values.
 
     Returns
     -------
@@ -428,8 +360,13 @@ def rpe(
 
     Notes
     -----
-    Computed in NumPy, as :func:`ape`: poses on torch or JAX are copied to
-    NumPy float64 (off the autograd graph) and the result holds NumPy arrays.
+    Poses on torch or JAX are compared in their own namespace, as by
+    :func:`ape`: the errors and statistics are differentiable with respect to
+    the poses. The pairs are integer indices, constants of the computation:
+    ``unit="frames"`` chooses them from the length alone (so ``jax.jit`` traces
+    the whole function), a metric unit from the poses' values (a detached NumPy
+    copy: under ``jax.jit`` or ``jax.grad``, whose poses are traced, pass
+    ``pairs=`` chosen outside).
 
     Examples
     --------
@@ -443,7 +380,9 @@ def rpe(
     ([[0, 1], [1, 2], [2, 3]], [0.1, 0.1, 0.1])
     """
     _check(relation, ref, est)
-    ref, est = _on_numpy(ref), _on_numpy(est)
+    xp = _namespace(ref, est)
+    if xp is None:
+        ref, est = _on_numpy(ref), _on_numpy(est)
     if pairs_from not in ("estimate", "reference"):
         raise ValueError(
             f"pairs_from must be 'estimate' or 'reference', got {pairs_from!r}"
@@ -451,12 +390,30 @@ def rpe(
     chooser = est if pairs_from == "estimate" else ref
     if len(chooser.shape) != 1:
         raise ShapeError("rpe takes one trajectory pair (poses of shape (N,)), not a batch")
-    pairs = pair_indices(chooser.poses, delta, unit, all_pairs, tolerance)
+    if pairs is not None:
+        pairs = _checked_pairs(pairs, len(ref))
+    else:
+        if xp is not None and unit != "frames":  # chosen from values: on the host
+            if not concrete(stored(chooser.poses)):
+                raise RigidkitError(
+                    f"rpe: pairs {delta!r} {unit} apart are chosen from the poses' "
+                    "values, which are traced here (jax.jit, jax.grad, torch.compile); "
+                    "choose them outside with rk.trajectory.pair_indices and pass pairs="
+                )
+            chooser = _on_numpy(chooser)
+        pairs = pair_indices(chooser.poses, delta, unit, all_pairs, tolerance)
     if len(pairs) == 0:
         raise ShapeError(
             f"no pose pair is {delta!r} {unit} apart in a trajectory of {len(ref)} poses"
         )
     i, j = pairs[:, 0], pairs[:, 1]
+    if xp is not None:
+        errors = _array_metrics.rpe_errors(xp, ref, est, i, j, relation, degrees)
+        stamps = None if ref.stamps is None else ref.stamps[i]
+        stats = _array_metrics.statistics(xp, errors)
+        return MetricResult(
+            errors, stamps, pairs, stats, relation, _unit(relation, degrees)
+        )
     pr, pe = np.asarray(ref.positions), np.asarray(est.positions)
     dr, de = pr[j] - pr[i], pe[j] - pe[i]  # the pairs' displacements, world axes
     if relation == "point_distance":
