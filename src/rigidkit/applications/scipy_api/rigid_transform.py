@@ -19,7 +19,7 @@ from ..._engine.namespace import namespace_of
 from ...objects.rotation import Rotation as _RkRotation
 from ...objects.transform import Transform as _RkTransform
 from ._arrays import as_float
-from .rotation import Rotation, _broadcast, _new, _shape_arg
+from .rotation import Rotation, _broadcast, _det3, _exponent, _new, _shape_arg
 
 __all__ = ["RigidTransform"]
 
@@ -75,6 +75,11 @@ class RigidTransform:
 
     def __init__(self, matrix, normalize=True, copy=True):
         m = _matrix_in(matrix)
+        if normalize and bool((_det3(m[..., :3, :3]) <= 0).any()):
+            raise ValueError(
+                "Non-positive determinant (left-handed or null coordinate frame) in "
+                "rotation matrix."
+            )
         self._t = _RkTransform.from_matrix(m, orthonormalize=True)
 
     # -- construction ------------------------------------------------------------------
@@ -226,9 +231,7 @@ class RigidTransform:
         return _tf(self._t @ other._t)
 
     def __pow__(self, n):
-        if getattr(n, "ndim", 0) != 0 or isinstance(n, (list, tuple)):
-            raise ValueError("Array exponent must be a scalar")
-        return _tf(self._t ** float(n))
+        return _tf(self._t ** _exponent(n))
 
     def inv(self):
         """The inverse transforms."""
@@ -245,19 +248,22 @@ class RigidTransform:
         t = self._t if nd else self._t.reshape(1)
         if weights is not None:
             w = as_float(weights)
-            try:
-                np.broadcast_shapes(tuple(w.shape), t.shape)
-            except ValueError:
+            if tuple(w.shape) != t.shape:
                 raise ValueError(
-                    "Expected `weights` to be broadcastable to the transform shape "
-                    f"{t.shape}, got {tuple(w.shape)}."
-                ) from None
+                    "Expected `weights` to match transform shape, got shape "
+                    f"{tuple(w.shape)} for {t.shape} transformations."
+                )
             if bool((w < 0).any()):
                 raise ValueError("`weights` must be non-negative.")
             weights = w
         return _tf(t.mean(weights, axis=axis))
 
     # -- container protocol ------------------------------------------------------------
+    @property
+    def _matrix(self):
+        # scipy's private name, read by its tests for the array type only.
+        return self.as_matrix()
+
     @property
     def single(self):
         """Whether this holds one transform (batch shape ``()``)."""
@@ -281,7 +287,7 @@ class RigidTransform:
         if p.ndim == 1:
             raise TypeError("Single transform is not subscriptable.")
         if isinstance(indexer, list):
-            indexer = np.asarray(indexer)
+            indexer = np.asarray(indexer, dtype=np.intp if not indexer else None)
         if isinstance(indexer, tuple):
             out = (
                 p[indexer + (Ellipsis, slice(None))]

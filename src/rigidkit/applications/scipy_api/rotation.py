@@ -13,6 +13,7 @@ import math
 
 import numpy as np
 
+from ...errors import RigidkitError
 from ...objects.rotation import Rotation as _RkRotation
 from ..alignment import align_vectors as _align_vectors
 from ..interpolation import Slerp as _RkSlerp
@@ -142,16 +143,37 @@ class Rotation:
     @staticmethod
     def from_euler(seq, angles, degrees=False):
         """From Euler angles: ``seq`` of 1 to 3 axes, UPPER intrinsic, lower extrinsic."""
-        return _new(_RkRotation.from_euler(seq, as_float(angles), degrees=degrees))
+        a = as_float(angles)
+        if (
+            isinstance(seq, str)
+            and 1 <= len(seq) <= 3
+            and a.ndim
+            and a.shape[-1] != len(seq)
+        ):
+            raise ValueError(
+                "Expected last dimension of `angles` to match number of sequence axes "
+                f"specified, got {a.shape[-1]}."
+            )
+        return _new(_RkRotation.from_euler(seq, a, degrees=degrees))
 
     @staticmethod
     def from_davenport(axes, order, angles, degrees=False):
         """From Davenport angles about 1 to 3 axes (``order`` "e" or "i")."""
-        return _new(
-            _RkRotation.from_davenport(
-                as_float(axes), order, as_float(angles), degrees=degrees
+        axes, angles = as_float(axes), as_float(angles)
+        _davenport_order(order)
+        n = 1 if axes.ndim == 1 else axes.shape[-2]
+        if (angles.ndim == 0 and n != 1) or (angles.ndim and angles.shape[-1] != n):
+            raise ValueError(
+                f"Expected `angles` to match number of axes, got {tuple(angles.shape)} "
+                f"angles and {tuple(axes.shape)} axes."
             )
-        )
+        try:
+            r = _RkRotation.from_davenport(axes, order, angles, degrees=degrees)
+        except RigidkitError as err:
+            if "orthogonal" in str(err):
+                raise ValueError("Consecutive axes must be orthogonal.") from err
+            raise
+        return _new(r)
 
     @staticmethod
     def identity(num=None, *, shape=None):
@@ -159,10 +181,13 @@ class Rotation:
         return _new(_RkRotation.identity(_shape_arg(num, shape)))
 
     @staticmethod
-    def random(num=None, rng=None, *, shape=None):
+    def random(num=None, rng=None, *, shape=None, random_state=None):
         """Uniformly distributed rotations (normalised 4-D Gaussian samples, drawn as
-        scipy draws them: the same ``rng`` gives the same rotations)."""
+        scipy draws them: the same ``rng`` gives the same rotations; ``random_state``
+        is scipy's legacy name of ``rng``)."""
         shp = _shape_arg(num, shape)
+        if random_state is not None:
+            rng = random_state
         sample = _rng(rng).normal(size=shp + (4,))
         return _new(_from_quat_rk(sample, scalar_first=False))
 
@@ -170,7 +195,20 @@ class Rotation:
     def create_group(group, axis="Z"):
         """The rotations of a finite symmetry group (``"I"``, ``"O"``, ``"T"``,
         ``"Dn"``, ``"Cn"``)."""
-        return _new(_RkRotation.create_group(group, axis))
+        if not isinstance(group, str):
+            raise ValueError("`group` argument must be a string")
+        axes = ["x", "y", "z", "X", "Y", "Z"]
+        if axis not in axes:
+            raise ValueError("`axis` must be one of " + ", ".join(axes))
+        if group in ("I", "O", "T"):
+            order = 0
+        elif group[:1] in ("C", "D") and group[1:].isdigit():
+            order = int(group[1:])
+            if order < 1:
+                raise ValueError("Group order must be positive")
+        else:
+            raise ValueError("`group` must be one of 'I', 'O', 'T', 'Dn', 'Cn'")
+        return _new(_RkRotation.create_group(group, axis.upper()))
 
     @staticmethod
     def concatenate(rotations):
@@ -274,9 +312,15 @@ class Rotation:
     def as_davenport(self, axes, order, degrees=False, *, suppress_warnings=False):
         """Davenport angles about three axes, shape (..., 3)."""
         axes = as_float(axes)
-        if suppress_warnings:
-            return _quiet(self._r.as_davenport, axes, order, degrees=degrees)
-        return self._r.as_davenport(axes, order, degrees=degrees)
+        _davenport_order(order)
+        try:
+            if suppress_warnings:
+                return _quiet(self._r.as_davenport, axes, order, degrees=degrees)
+            return self._r.as_davenport(axes, order, degrees=degrees)
+        except RigidkitError as err:
+            if "orthogonal" in str(err):
+                raise ValueError("Consecutive axes must be orthogonal.") from err
+            raise
 
     def as_rigidkit(self):
         """The :class:`rigidkit.Rotation` holding these rotations (immutable)."""
@@ -312,7 +356,7 @@ class Rotation:
     def __pow__(self, n, modulus=None):
         if modulus is not None:
             raise NotImplementedError("modulus not supported")
-        return _new(self._r**n)
+        return _new(self._r ** _exponent(n))
 
     def inv(self):
         """The inverse rotations."""
@@ -336,9 +380,15 @@ class Rotation:
             atol = 1e-8
         elif degrees:
             atol = math.radians(atol)
-        sa, sb = self._r._quat.shape[:-1], other._r._quat.shape[:-1]
+        sa, sb = tuple(self._r._quat.shape[:-1]), tuple(other._r._quat.shape[:-1])
         if sa != sb and sa and sb:
-            _broadcast(sa, sb, "rotations")
+            try:
+                np.broadcast_shapes(sa, sb)
+            except ValueError:
+                raise ValueError(
+                    f"Expected broadcastable shapes in both rotations, got {sa} "
+                    f"rotations in first and {sb} rotations in second object."
+                ) from None
         return self._r.angle_to(other._r) <= atol
 
     def mean(self, weights=None, axis=None):
@@ -365,7 +415,8 @@ class Rotation:
             if nd == 0 and w.ndim == 0:
                 w = w[None]
             try:
-                np.broadcast_shapes(tuple(w.shape), r.shape)
+                if np.broadcast_shapes(tuple(w.shape), r.shape) != r.shape:
+                    raise ValueError
             except ValueError:
                 raise ValueError(
                     "Expected `weights` to be broadcastable to the rotation shape "
@@ -389,6 +440,11 @@ class Rotation:
         return _new(out)
 
     # -- container protocol ------------------------------------------------------------
+    @property
+    def _quat(self):
+        # scipy's private name, read by its tests for the array type only.
+        return self._r._quat
+
     @property
     def single(self):
         """Whether this holds one rotation (batch shape ``()``)."""
@@ -418,7 +474,7 @@ class Rotation:
             out = q[idx]
         else:
             if isinstance(indexer, list):
-                indexer = np.asarray(indexer)
+                indexer = np.asarray(indexer, dtype=np.intp if not indexer else None)
             out = q[indexer]
         return _new(_wrap_rk(out))
 
@@ -529,6 +585,25 @@ def _primary_nonzero(a, b, w):
     k = 0 if w is None else int(np.argmax(np.asarray(w) == math.inf))
     if not (bool((a[k] ** 2).sum() > 0) and bool((b[k] ** 2).sum() > 0)):
         raise ValueError("Cannot align zero length primary vectors")
+
+
+def _exponent(n):
+    """A power's exponent as a float: a number or an array of one element (scipy's)."""
+    if isinstance(n, (int, float)):
+        return n
+    size = getattr(n, "size", None)
+    size = size() if callable(size) else size
+    if isinstance(n, (list, tuple)) or (size is not None and size != 1):
+        raise ValueError("Array exponent must be a scalar")
+    return float(n if size is None or getattr(n, "ndim", 0) == 0 else n.reshape(()))
+
+
+def _davenport_order(order):
+    if order not in ("e", "extrinsic", "i", "intrinsic"):
+        raise ValueError(
+            "order should be 'e'/'extrinsic' for extrinsic sequences or 'i'/"
+            f"'intrinsic' for intrinsic sequences, got {order!r}"
+        )
 
 
 def _quiet(fn, *args, **kwargs):
