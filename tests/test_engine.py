@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import importlib
 import math
+import os
 import subprocess
 import sys
 import textwrap
@@ -1273,6 +1274,63 @@ def _fresh(code, timeout=300):
     )
     assert res.returncode == 0, res.stderr[-3000:]
     return res.stdout.strip()
+
+
+def test_cached_loops_load_without_numba_set_up(tmp_path):
+    """A loop in the disk cache is loaded without numba's first-use set-up (its
+    registries, ``numba.np.arraymath`` and the ``scipy.linalg`` import of its BLAS
+    probe: 1-2 s of a fresh process), and computes what scipy does; a compile
+    after such loads (a host loop that allocates, with numba's runtime) works."""
+    if not numba_backend.available():
+        pytest.skip("needs numba")
+    code = """
+        import sys
+        import numpy as np
+        import rigidkit as rk
+        from rigidkit._engine import drain
+        from rigidkit._engine.loop_source import SINGLE
+        from rigidkit.functional import conversions
+        from scipy.spatial.transform import Rotation
+        r = np.array([0.3, -0.2, 0.5])
+        for dt in (np.float64, np.float32):
+            for _ in range(70):  # one-element calls: past SINGLE_HOT
+                R = rk.Rotation.from_rotvec(r.astype(dt))
+                m = R.as_matrix()
+        drain(timeout=250)
+        kern = conversions.matrix_from_quat_unchecked
+        loop = kern._ready[SINGLE][np.dtype(np.float32)]
+        print(type(loop).__name__, sum(loop.stats.cache_hits.values()))
+        ref = Rotation.from_rotvec(r).as_matrix()
+        for dt in (np.float64, np.float32):
+            m = rk.Rotation.from_rotvec(r.astype(dt)).as_matrix()
+            tol = 1e-15 if dt is np.float64 else 1e-6
+            assert m.dtype == dt and np.abs(m - ref).max() < tol, (dt, m - ref)
+        print("numba.np.arraymath" in sys.modules)
+        if sys.argv[-1] == "compile":
+            # numba's runtime linked in by this first compile's set-up
+            R = rk.Rotation.random(50, rng=0)
+            print(R.mean().as_quat().shape == (4,))
+            drain(timeout=250)
+            from rigidkit.functional import averaging
+            print(averaging._gram_ready())
+        """
+    env = dict(os.environ, RIGIDKIT_CACHE_DIR=str(tmp_path))
+    env.pop("RIGIDKIT_DISABLE_NUMBA", None)
+
+    def run(*argv):
+        res = subprocess.run(
+            [sys.executable, "-c", textwrap.dedent(code), *argv],
+            capture_output=True,
+            text=True,
+            timeout=300,
+            env=env,
+        )
+        assert res.returncode == 0, res.stderr[-3000:]
+        return res.stdout.split()
+
+    assert run() == ["CPUDispatcher", "0", "True"]  # cold: compiled, numba set up
+    assert run() == ["CPUDispatcher", "1", "False"]  # warm: loaded, no set-up
+    assert run("compile") == ["CPUDispatcher", "1", "False", "True", "True"]
 
 
 def test_every_compile_runs_on_one_background_thread():
