@@ -518,12 +518,12 @@ def test_malformed_row_exit_2_and_no_output(
 @pytest.mark.parametrize(
     "extra, words",
     [
-        (["--to", "quat", "-o", "{d}/out.txt"], ["format of output", ".npy or .csv"]),
+        (["--to", "quat", "-o", "{d}/out.dat"], ["format of output", ".npy, .csv or .txt"]),
         (["--to", "quat", "-o", "{d}/missing/out.npy"], ["cannot write", "No such file"]),
         (["-o", "{d}/out.npy"], ["needs --to"]),
         (["--to", "quaternion", "-o", "{d}/out.npy"], ["unknown representation"]),
         (["--to", "quat", "-o", "-", "rotvec"], ["give no rotation"]),
-        (["--to", "quat", "-o", "-", "--decimals", "3"], ["--decimals", "one rotation"]),
+        (["--to", "quat", "-o", "-", "--format", "json"], ["--format", "one rotation"]),
     ],
 )
 def test_batch_argument_errors(extra, words, tmp_path, capsys):
@@ -553,7 +553,7 @@ def test_a_failed_write_leaves_no_file_behind(
     np.save(tmp_path / "in.npy", np.eye(4))
     (tmp_path / out_name).write_bytes(b"precious")
 
-    def write_half_then_fail(stream, *args):
+    def write_half_then_fail(stream, *args, **kwargs):
         stream.write(b"partial" if "b" in stream.mode else "partial")
         raise failure
 
@@ -749,7 +749,7 @@ def _columns(header, rows, order):
         ("QW, QX, QY, QZ", [0, 1, 2, 3], "quat"),
         ("quat.w,quat.x,quat.y,quat.z", [0, 1, 2, 3], "quat:xyzw"),
         ("quat:xyzw.x,quat:xyzw.y,quat:xyzw.z,quat:xyzw.w", [1, 2, 3, 0], "quat"),
-        ("a,b,c,d", [0, 1, 2, 3], "quat"),  # names no component: file order
+        ("a,b,c,d", [0, 1, 2, 3], "quat"),  # names no component: file order, warned
     ],
 )
 def test_a_header_naming_quaternion_components_is_honoured(
@@ -757,7 +757,12 @@ def test_a_header_naming_quaternion_components_is_honoured(
 ):
     text = _columns(header, Q_WXYZ, order)
     code, table, err = convert_file(tmp_path, capsys, text, source, to="quat")
-    assert (code, err) == (0, "")
+    if header == "a,b,c,d":  # an unrecognised header is said, not skipped silently
+        assert code == 0 and err.count("\n") == 1
+        assert "warning" in err and "line 1" in err and "(a, b, c, d)" in err
+        assert "read in the order w, x, y, z" in err
+    else:
+        assert (code, err) == (0, "")
     check_against_scipy("quat", table, SciRot.from_quat(np.roll(Q_WXYZ, -1, axis=-1)), 0)
 
 
@@ -930,3 +935,167 @@ def test_console_script():
         check_against_scipy(name, got, S, degrees=True)
     res = _subprocess([script, "convert", "rotvec", "1", "2", "3", "--to", "nope"])
     assert res.returncode == 2 and res.stderr.count("\n") == 1
+
+
+# -- the files people have (issue 21, part 4) ---------------------------------------------
+
+EULER_ROWS = np.array([[10.0, 20.0, 30.0], [-40.0, 5.0, 170.0], [0.5, -60.0, 1.0]])
+
+
+def test_txt_files_are_read_whitespace_separated_as_tum_and_kitti_logs(tmp_path, capsys):
+    # A TUM-style log: a '#' comment line, then columns separated by runs of spaces.
+    text = "# roll pitch yaw, degrees\n" + "\n".join(
+        "  ".join(f"{v:.10f}" for v in row) for row in EULER_ROWS
+    )
+    code, table, err = convert_file(
+        tmp_path, capsys, text, "euler:xyz", extra=["--degrees"], name="in.txt"
+    )
+    assert (code, err) == (0, "")
+    check_against_scipy(
+        "quat", table, SciRot.from_euler("xyz", EULER_ROWS, degrees=True), 0
+    )
+    # .txt out: numbers separated by spaces under a '#' header, read back the same.
+    out = tmp_path / "out.txt"
+    argv = ["convert", "rpy", "-i", tmp_path / "in.txt", "-o", out, "--to", "quat"]
+    assert run(argv + ["--degrees"], capsys)[0] == 0
+    lines = out.read_text().splitlines()
+    assert lines[0] == "# quat.w quat.x quat.y quat.z"
+    np.testing.assert_array_equal(np.loadtxt(out), table)
+
+
+def test_rpy_is_roll_pitch_yaw_about_the_fixed_axes_in_that_order(capsys):
+    roll, pitch, yaw = 10.0, 20.0, 30.0
+    code, out, _ = run(
+        [
+            "convert",
+            "rpy",
+            roll,
+            pitch,
+            yaw,
+            "--degrees",
+            "--to",
+            "matrix",
+            "--format",
+            "json",
+        ],
+        capsys,
+    )
+    assert code == 0
+    # ROS / URDF: R = Rz(yaw) Ry(pitch) Rx(roll), the same as intrinsic ZYX (y, p, r).
+    ref = SciRot.from_euler("ZYX", [yaw, pitch, roll], degrees=True).as_matrix()
+    np.testing.assert_allclose(json.loads(out)["matrix"], ref, rtol=0, atol=ATOL)
+    code, out, _ = run(["convert", "euler:ZYX", yaw, pitch, roll, "--degrees",
+                        "--to", "rpy", "--format", "json"], capsys)  # fmt: skip
+    np.testing.assert_allclose(json.loads(out)["rpy"], [roll, pitch, yaw], atol=1e-12)
+    code, out, _ = run(["convert", "--help"], capsys)
+    assert code == 0
+    assert "rpy" in out and "roll, pitch, yaw in that order" in out
+
+
+def _numbers(text: str) -> list:
+    """Every number token of an output (table, JSON, CSV or whitespace text)."""
+    out = []
+    for token in text.replace(",", " ").replace("[", " ").replace("]", " ").split():
+        try:
+            float(token)
+        except ValueError:
+            continue
+        out.append(token)
+    return out
+
+
+def test_decimals_apply_to_every_output_format(tmp_path, capsys):
+    np.save(tmp_path / "in.npy", EULER_ROWS)
+    base = ["convert", "--from", "euler:ZYX", "-i", tmp_path / "in.npy", "--to", "quat",
+            "--degrees", "--decimals", "3"]  # fmt: skip
+    ref = SciRot.from_euler("ZYX", EULER_ROWS, degrees=True).as_quat(scalar_first=True)
+    ref = np.round(ref * np.sign(ref[:, :1]), 3) + 0.0
+    for name in ("out.csv", "out.txt", "out.npy"):
+        assert run(base + ["-o", tmp_path / name], capsys)[0] == 0
+        path = tmp_path / name
+        if name.endswith(".npy"):
+            got = np.load(path)
+        else:
+            body = path.read_text().splitlines()[1:]
+            assert all(len(t.split(".")[1]) == 3 for t in _numbers("\n".join(body)))
+            got = np.loadtxt(path, delimiter="," if name.endswith("csv") else None,
+                             skiprows=1)  # fmt: skip
+        np.testing.assert_array_equal(got, ref)
+    code, out, _ = run(base + ["-o", "-"], capsys)
+    assert all(len(t.split(".")[1]) == 3 for t in _numbers(out.split("\n", 1)[1]))
+    code, out, _ = run(["convert", "euler:ZYX", 10, 20, 30, "--degrees", "--to", "quat",
+                        "--format", "json", "--decimals", "2"], capsys)  # fmt: skip
+    got = json.loads(out)["quat"]
+    np.testing.assert_array_equal(got, ref[0].round(2))
+
+
+def test_no_negative_zero_is_ever_written(tmp_path, capsys):
+    # (x, y, z, w) = (-0, 0, 0, 1): the library keeps the sign of the zero ...
+    q = np.array([[-0.0, 0.0, 0.0, 1.0], [-1e-9, -0.0, 0.0, 1.0]])
+    assert np.signbit(rk_quat_xyzw_rotvec(q)).any()
+    np.save(tmp_path / "in.npy", q)
+    for extra in ([], ["--decimals", "4"]):
+        for out in ("-", tmp_path / "out.csv", tmp_path / "out.txt"):
+            argv = ["convert", "--from", "quat:xyzw", "-i", tmp_path / "in.npy", "-o", out,
+                    "--to", "all", *extra]  # fmt: skip
+            code, stdout, _ = run(argv, capsys)
+            text = stdout if out == "-" else Path(out).read_text()
+            assert code == 0 and _numbers(text)
+            assert not [t for t in _numbers(text) if t.startswith("-") and float(t) == 0]
+        npy = tmp_path / "out.npy"
+        argv = ["convert", "--from", "quat:xyzw", "-i", tmp_path / "in.npy", "-o", npy,
+                "--to", "all", *extra]  # fmt: skip
+        assert run(argv, capsys)[0] == 0
+        got = np.load(npy)
+        assert not np.signbit(got[got == 0]).any()
+        for fmt in ("table", "json"):
+            argv = ["convert", "quat:xyzw", "-0.0", "0", "0", "1", "--to", "all"]
+            code, stdout, _ = run([*argv, "--format", fmt, *extra], capsys)
+            assert code == 0
+            assert not [t for t in _numbers(stdout) if t.startswith("-") and float(t) == 0]
+
+
+def rk_quat_xyzw_rotvec(q):
+    import rigidkit as rk
+
+    return rk.Rotation.from_quat(q, scalar_first=False).as_rotvec()
+
+
+@pytest.mark.parametrize(
+    "separator",
+    [",", ";", "\t", " ", "  \t "],
+    ids=["comma", "semicolon", "tab", "space", "spaces"],
+)
+def test_convert_help_lists_every_separator_the_reader_accepts(separator, tmp_path, capsys):
+    code, out, _ = run(["convert", "--help"], capsys)
+    help_text = " ".join(out.split())
+    for words in ("commas (,)", "semicolons (;)", "tabs", "runs of spaces and tabs"):
+        assert words in help_text
+    text = "\n".join(separator.join(repr(float(v)) for v in row) for row in EULER_ROWS)
+    code, table, err = convert_file(
+        tmp_path, capsys, text, "euler:ZYX", extra=["--degrees"]
+    )
+    assert (code, err) == (0, "")
+    check_against_scipy(
+        "quat", table, SciRot.from_euler("ZYX", EULER_ROWS, degrees=True), 0
+    )
+
+
+def test_the_gimbal_lock_warning_speaks_of_rows(tmp_path, capsys):
+    rows = np.array([[0.0, 0.0, 0.0], [10.0, 90.0, 0.0], [1.0, 2.0, 3.0], [0.0, 90.0, 5.0]])
+    code, table, err = convert_file(
+        tmp_path, capsys, "\n".join(",".join(str(float(v)) for v in r) for r in rows),
+        "euler:ZYX", to="euler:ZYX", extra=["--degrees"],
+    )  # fmt: skip
+    assert code == 0 and err.count("\n") == 1
+    assert "line 2 (data row 2)" in err and "2 of 4 rows have their middle angle" in err
+    assert "middle angles" not in err and "(first" not in err
+    # The angles returned rebuild the rotations (scipy's matrices).
+    np.testing.assert_allclose(
+        SciRot.from_euler("ZYX", table, degrees=True).as_matrix(),
+        SciRot.from_euler("ZYX", rows, degrees=True).as_matrix(), atol=1e-12,
+    )  # fmt: skip
+    code, _, err = run(["convert", "euler:ZYX", 0, 90, 0, "--degrees", "--to", "euler:ZYX"],
+                       capsys)  # fmt: skip
+    assert code == 0 and "the middle angle is within" in err
+    assert "(single)" not in err and "batch" not in err

@@ -59,10 +59,10 @@ def run_convert(args) -> int:
         return _convert_one(args, to or targets(["all"]))
     if to is None:
         raise CLIError("a batch needs --to TARGET ... (the representations to write)")
-    if args.decimals is not None or args.format != "table":
+    if args.format != "table":
         raise CLIError(
-            "--decimals and --format are for one rotation; batch files always hold "
-            "every digit"
+            "--format is for one rotation; a batch is written as its file's extension "
+            "says (.csv, .txt or .npy)"
         )
     return _convert_batch(args, to)
 
@@ -83,7 +83,7 @@ def _convert_one(args, to) -> int:
     warn_if_degrees(source, values, args.degrees)
     outputs = convert(source, values, to, args.degrees, orthonormalize=args.orthonormalize)
     if args.format == "json":
-        print(json_document(to, outputs, args.degrees))
+        print(json_document(to, outputs, args.degrees, args.decimals))
     else:
         print(format_table(table_rows(to, outputs, args.degrees), args.decimals))
     return 0
@@ -149,10 +149,18 @@ def _convert_batch(args, to) -> int:
             f"{len(values)} rows read but {table.shape[0]} converted; nothing written"
         )
     header = column_names(to)
+    digits = args.decimals
     if output == "-":
-        write_csv(sys.stdout, header, table)
+        write_csv(sys.stdout, header, table, decimals=digits)
     elif out_kind == "npy":
-        write_atomically(output, lambda f: write_npy(f, table), binary=True)
+        write_atomically(
+            output, lambda f: write_npy(f, table, decimals=digits), binary=True
+        )
     else:
-        write_atomically(output, lambda f: write_csv(f, header, table), binary=False)
+        sep = " " if out_kind == "txt" else ","
+        write_atomically(
+            output,
+            lambda f: write_csv(f, header, table, decimals=digits, separator=sep),
+            binary=False,
+        )
     return 0

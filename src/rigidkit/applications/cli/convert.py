@@ -8,6 +8,7 @@ an error or warning without an index is located by bisection over the rows.
 from __future__ import annotations
 
 import math
+import re
 import sys
 import warnings
 
@@ -60,10 +61,30 @@ def convert(source, values, targets, degrees, *, orthonormalize=False, where=Non
             if row is None:
                 row = _first_row(lambda n: _warns(attempt, values[:n]), len(values))
             text = f"{where(row)}: {_without_index(text, row)}"
+        text = in_rows(text)
         if text not in shown:
             shown.add(text)
             warn(text)
     return outputs
+
+
+def in_rows(text: str) -> str:
+    """A gimbal-lock warning in command-line words: rows, not batch elements.
+
+    >>> in_rows("Gimbal lock in 'XYZ': 2 of 5 middle angles are within 1e-08 rad of "
+    ...         "+-pi/2 (first); there ...")[22:]
+    '2 of 5 rows have their middle angle within 1e-08 rad of +-pi/2; there ...'
+    """
+    text = text.replace(" (first in the (single) input)", "").replace(" (first)", "")
+
+    def words(m):
+        count, total = int(m[1]), int(m[2])
+        if total == 1:
+            return "the middle angle is within"
+        rows = "rows has its" if count == 1 else "rows have their"
+        return f"{count} of {total} {rows} middle angle within"
+
+    return re.sub(r"(\d+) of (\d+) middle angles are within", words, text)
 
 
 def _error_text(exc: RigidkitError, attempt, values, where) -> str:

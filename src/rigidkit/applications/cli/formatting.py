@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
+
 __all__ = ["format_table", "json_document", "table_rows"]
 
 
@@ -73,10 +75,22 @@ def table_rows(targets, outputs, degrees) -> list:
     return rows
 
 
-def json_document(targets, outputs, degrees) -> str:
-    """``{"degrees": ..., TARGET: numbers}``; a matrix as a list of three rows."""
+def json_document(targets, outputs, degrees, decimals=None) -> str:
+    """``{"degrees": ..., TARGET: numbers}``; a matrix as a list of three rows.
+
+    Numbers rounded to ``decimals`` when given, never ``-0.0``.
+
+    >>> from .representations import representation
+    >>> print(json_document([representation("rotvec")], [np.array([-0.0, 1e-9, 1 / 3])],
+    ...                     False, 4).replace(chr(10), ""))
+    {  "degrees": false,  "rotvec": [    0.0,    0.0,    0.3333  ]}
+    """
     doc = {"degrees": degrees}
     for rep, out in zip(targets, outputs, strict=True):
-        values = out.reshape(3, 3) if rep.kind == "matrix" else out
+        values = np.asarray(out, dtype=np.float64)
+        if decimals is not None:
+            values = np.round(values, decimals)
+        values = values + 0.0  # no negative zero
+        values = values.reshape(3, 3) if rep.kind == "matrix" else values
         doc[rep.name] = values.tolist()  # Python floats: json writes them as repr
     return json.dumps(doc, indent=2)

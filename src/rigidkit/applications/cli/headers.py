@@ -4,14 +4,15 @@ A header such as ``qx,qy,qz,qw`` says in which order the numbers come; reading
 those columns as ``w, x, y, z`` would silently give another rotation. So a
 header naming components is honoured (the columns are reordered) when it names
 each component of the representation once, and is an error when it names
-others; a header of other words (``a,b,c``, ``time,...``) is ignored.
+others; a header of other words (``a,b,c``, ``time,...``) names nothing: the
+reader warns that the columns are taken in the representation's order.
 """
 
 from __future__ import annotations
 
 from .representations import CLIError, is_representation
 
-__all__ = ["header_order"]
+__all__ = ["accepted", "header_order"]
 
 # Roll, pitch and yaw are the angles about x, y and z (aerospace ZYX is
 # yaw-pitch-roll, ROS's fixed-axis RPY is xyz), so they name the angles of any
@@ -76,7 +77,7 @@ def _component(rep, name: str) -> str | None:
     return comp if comp in rep.columns else None
 
 
-def _accepted(rep) -> str:
+def accepted(rep) -> str:
     names = ", ".join(rep.columns)
     if _three_axes(rep):
         about = {axis: name for name, axis in _ANGLE_ABOUT.items()}
@@ -108,6 +109,6 @@ def header_order(rep, fields) -> list | None:
         return [found.index(c) for c in rep.columns]
     raise CLIError(
         f"the header ({', '.join(names)}) does not name the {rep.size} columns of "
-        f"{rep.name} ({_accepted(rep)}); fix the representation, or rename or "
+        f"{rep.name} ({accepted(rep)}); fix the representation, or rename or "
         "remove the header"
     )

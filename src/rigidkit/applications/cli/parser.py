@@ -22,6 +22,9 @@ representations (REPR, and the names --to accepts):
   euler:SEQ    3 numbers            angles in sequence order; SEQ is three letters of
                                     xyz, UPPER = intrinsic (body axes, e.g. ZYX =
                                     yaw-pitch-roll), lower = extrinsic (world axes)
+  rpy          3 numbers  r p y     roll, pitch, yaw in that order, as ROS, URDF and
+                                    tf write them: about the fixed x, y, z axes
+                                    (= euler:xyz; euler:ZYX takes yaw pitch roll)
   all          (--to only) quat, quat:xyzw, matrix, rotvec, axis-angle, mrp and
                euler:ZYX, XYZ, ZXZ, ZYZ, xyz
 
@@ -38,24 +41,29 @@ _CONVERT_EPILOG = (
 one rotation: rigidkit convert REPR VALUE ... [--to TARGET ...]
   Prints a table, one line per target (three for matrix); the first column is the
   name to pass back as REPR. Numbers are printed with every digit needed to read
-  back the same float64 (Python repr); --decimals N rounds them for reading.
+  back the same float64 (Python repr); --decimals N rounds them (in the table,
+  JSON and batch files alike). A negative zero is printed as 0.
   Default --to: all. Negative numbers need no quoting (euler:ZYX -30 20 10).
 
 batch: rigidkit convert [--from] REPR -i IN -o OUT --to TARGET ...
-  IN and OUT are .npy or .csv files (- is CSV on stdin / stdout). Input .npy: a
-  float array of shape (N, k), k the numbers per rotation (matrix also (N, 3, 3)).
-  Input .csv: k numbers per line, separated by commas, semicolons or tabs (the
-  one that splits the lines into k fields), optionally in double quotes; blank
-  lines and lines starting with # are skipped. The first line is a header, and
-  skipped, only if none of its fields is a number. A header naming the
-  components (w,x,y,z or qx,qy,qz,qw; m11..m33; angle1..3 or roll,pitch,yaw
-  for Euler sequences about three different axes; or this command's own
-  TARGET.COMPONENT) sets the order of the columns; one naming other components
-  than REPR's is an error. Output: the targets' columns side by side, in --to
-  order (quat: w x y z; matrix: m11 m12 ... m33 row-major; axis-angle: x y z
-  angle), as a float64 array of shape (N, total columns) in .npy, or as CSV with
-  a header line naming each column TARGET.COMPONENT (quat.w, matrix.m12,
-  euler:ZYX.angle1) and numbers written as shortest round-trip repr. All
+  IN and OUT are .npy, .csv or .txt files (- is CSV on stdin / stdout). Input
+  .npy: a float array of shape (N, k), k the numbers per rotation (matrix also
+  (N, 3, 3)). Input .csv or .txt: k numbers per line, separated by commas (,),
+  semicolons (;), tabs, or runs of spaces and tabs (as in TUM and KITTI logs),
+  whichever splits the lines into k fields; with commas, semicolons or tabs a
+  field may be in double quotes. Blank lines and lines starting with # are
+  skipped. The first line is a header only if none of its fields is a number.
+  A header naming the components (w,x,y,z or qx,qy,qz,qw; m11..m33; angle1..3
+  or roll,pitch,yaw for Euler sequences about three different axes; or this
+  command's own TARGET.COMPONENT) sets the order of the columns; one naming
+  other components than REPR's is an error, and one naming none is read with a
+  warning (the columns taken in REPR's order). Output: the targets' columns
+  side by side, in --to order (quat: w x y z; matrix: m11 m12 ... m33
+  row-major; axis-angle: x y z angle), as a float64 array of shape (N, total
+  columns) in .npy, as CSV with a header line naming each column
+  TARGET.COMPONENT (quat.w, matrix.m12, euler:ZYX.angle1), or as .txt with the
+  numbers separated by spaces under a '# ' header line. Numbers are written as
+  shortest round-trip repr, or rounded to --decimals N in every format. All
   arithmetic is float64. Errors name the row: 1-based data row (CSV: header,
   comments and blank lines are not counted; the file line number is given too;
   .npy: row i is index i - 1). On any error nothing is written and an existing
@@ -133,15 +141,21 @@ def build_parser(run_convert) -> argparse.ArgumentParser:
         help="matrix input: use the nearest rotation (SVD) instead of rejecting a matrix "
         "that is not a rotation within 1e-5 (e.g. one typed with few digits)",
     )
-    convert.add_argument("-i", "--input", metavar="IN", help="batch input: .npy, .csv or -")
     convert.add_argument(
-        "-o", "--output", metavar="OUT", help="batch output: .npy, .csv or - (default -)"
+        "-i", "--input", metavar="IN", help="batch input: .npy, .csv, .txt or -"
+    )
+    convert.add_argument(
+        "-o",
+        "--output",
+        metavar="OUT",
+        help="batch output: .npy, .csv, .txt or - (default -)",
     )
     convert.add_argument(
         "--decimals",
         type=_nonnegative_int,
         metavar="N",
-        help="one rotation: print N decimals instead of all round-trip digits",
+        help="round every number written (table, JSON, .csv, .txt, .npy) to N "
+        "decimals instead of all round-trip digits",
     )
     convert.add_argument(
         "--format",

@@ -22,8 +22,8 @@ import warnings
 
 import numpy as np
 
-from .convert import one_line
-from .headers import header_order
+from .convert import one_line, warn
+from .headers import accepted, header_order
 from .representations import CLIError, is_number
 
 __all__ = ["kind_of", "os_text", "read_csv", "read_npy"]
@@ -40,15 +40,19 @@ def os_text(exc: Exception) -> str:
 
 
 def kind_of(path: str, what: str) -> str:
-    """``"npy"`` or ``"csv"`` from a file's extension (``-`` is CSV)."""
+    """``"npy"``, ``"csv"`` or ``"txt"`` from a file's extension (``-`` is CSV).
+
+    ``.txt`` is read as CSV (whitespace-separated columns are detected, as in TUM
+    and KITTI logs) and written with the numbers separated by spaces.
+    """
     if path == "-":
         return "csv"
     ext = os.path.splitext(path)[1].lower()
-    if ext in (".npy", ".csv"):
+    if ext in (".npy", ".csv", ".txt"):
         return ext[1:]
     raise CLIError(
         f"cannot tell the format of {what} {path!r} from its extension; "
-        "use a .npy or .csv file (or - for CSV on stdin/stdout)"
+        "use a .npy, .csv or .txt file (or - for CSV on stdin/stdout)"
     )
 
 
@@ -165,6 +169,13 @@ def read_csv(path: str, source):
             order = header_order(source, first)
         except CLIError as exc:
             raise CLIError(f"{name} line {numbers[0]}: {exc}") from None
+        if order is None:  # said, not skipped silently: the order is a guess
+            names = ", ".join(f.strip().strip('"').strip() for f in first)
+            warn(
+                f"{name} line {numbers[0]}: the header ({names}) names none of the "
+                f"components of {source.name} ({accepted(source)}); its columns are "
+                f"read in the order {', '.join(source.columns)}"
+            )
         start = numbers.pop(0)  # the header line
     else:
         start = numbers[0] - 1

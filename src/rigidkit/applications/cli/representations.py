@@ -130,8 +130,18 @@ _FIXED = {
     ),
     "mrp": Representation("mrp", ("x", "y", "z"), "x y z"),
 }
+# Roll-pitch-yaw as ROS (REP 103), URDF and tf write it: roll about the fixed x
+# axis, then pitch about fixed y, then yaw about fixed z, the angles in that order
+# (roll, pitch, yaw): extrinsic xyz, which is intrinsic ZYX with the angles reversed.
+_FIXED["rpy"] = Representation(
+    "rpy",
+    ("angle1", "angle2", "angle3"),
+    "roll pitch yaw (x y z extrinsic)",
+    angle_unit=True,
+    seq="xyz",
+)
 # The explicit spelling of the default order is accepted too.
-_ALIASES = {"quat:wxyz": "quat"}
+_ALIASES = {"quat:wxyz": "quat", "euler:rpy": "rpy"}
 
 #: What ``--to all`` prints, in order. The Euler sequences are the common ones:
 #: ZYX (yaw-pitch-roll, aerospace), XYZ, ZXZ (classical), ZYZ (robot wrists), and
@@ -150,7 +160,9 @@ ALL = (
     "euler:xyz",
 )
 
-_NAMES_HELP = "quat, quat:xyzw, matrix, rotvec, axis-angle, mrp, euler:SEQ (e.g. euler:ZYX)"
+_NAMES_HELP = (
+    "quat, quat:xyzw, matrix, rotvec, axis-angle, mrp, rpy, euler:SEQ (e.g. euler:ZYX)"
+)
 
 
 def representation(name: str) -> Representation:

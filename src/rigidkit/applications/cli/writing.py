@@ -16,7 +16,7 @@ import numpy as np
 from .reading import os_text
 from .representations import CLIError
 
-__all__ = ["column_names", "write_atomically", "write_csv", "write_npy"]
+__all__ = ["column_names", "rounded", "write_atomically", "write_csv", "write_npy"]
 
 
 def column_names(targets) -> list:
@@ -24,16 +24,39 @@ def column_names(targets) -> list:
     return [f"{t.name}.{c}" for t in targets for c in t.columns]
 
 
-def write_csv(stream, header, table) -> None:
-    """CSV with a header line; numbers as shortest round-trip ``repr``."""
-    stream.write(",".join(header) + "\n")
+def rounded(table, decimals=None):
+    """``table`` rounded to ``decimals`` (None: as is), with no negative zero.
+
+    ``-0.0`` (and anything that rounds to it, ``-1e-17`` at 6 decimals) becomes
+    ``0.0``: adding ``+0.0`` turns a negative zero positive and changes no other
+    float.
+
+    >>> rounded(np.array([-0.0, -1e-17, 0.123456789]), 3).tolist()
+    [0.0, 0.0, 0.123]
+    """
+    table = np.asarray(table, dtype=np.float64)
+    if decimals is not None:
+        table = np.round(table, decimals)
+    return table + 0.0
+
+
+def write_csv(stream, header, table, *, decimals=None, separator=",") -> None:
+    """CSV with a header line; numbers as shortest round-trip ``repr``, or with
+    ``decimals`` decimals. ``separator=" "`` writes a whitespace-separated text
+    file whose header is a ``#`` comment (as TUM logs have)."""
+    if separator == ",":
+        stream.write(",".join(header) + "\n")
+    else:
+        stream.write("# " + separator.join(header) + "\n")
     if table.shape[0] == 0:
         return
+    table = rounded(table, decimals)
     # One format string per block of rows: far fewer Python calls than a loop
     # over rows (np.savetxt), and repr of each float64 reads back exactly.
     block = 4096
     ncol = table.shape[1]
-    row_fmt = ",".join(["%r"] * ncol) + "\n"
+    cell = "%r" if decimals is None else f"%.{decimals}f"
+    row_fmt = separator.join([cell] * ncol) + "\n"
     full = row_fmt * block
     for start in range(0, table.shape[0], block):
         chunk = table[start : start + block]
@@ -41,8 +64,8 @@ def write_csv(stream, header, table) -> None:
         stream.write(fmt % tuple(chunk.ravel().tolist()))
 
 
-def write_npy(stream, table) -> None:
-    np.save(stream, table)
+def write_npy(stream, table, *, decimals=None) -> None:
+    np.save(stream, rounded(table, decimals))
 
 
 def write_atomically(path: str, write_to, *, binary: bool) -> None:
