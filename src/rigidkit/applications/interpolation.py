@@ -34,7 +34,10 @@ __all__ = ["slerp", "Slerp"]
 
 
 def slerp(a, b, t, *, decoupled=False):
-    """The point at fraction ``t`` of the geodesic from ``a`` to ``b``.
+    """Fraction ``t`` of the geodesic a to b: Transforms on the screw; decoupled=True: tf's.
+
+    For two ``Transform`` the geodesic is the SE(3) screw motion; ``decoupled=True``
+    slerps the rotation and interpolates the translation linearly, as tf2 and evo do.
 
     Parameters
     ----------
