@@ -204,3 +204,62 @@ def test_zero_error_has_a_finite_gradient(torch):
     (r.stats["rmse"] + r.stats["std"] + r.stats["mean"]).backward()
     assert float(r.stats["rmse"].detach()) == 0.0
     assert torch.isfinite(x.grad).all() and float(x.grad.abs().max()) == 0.0
+
+
+@pytest.mark.parametrize("method", ["nearest", "interpolate"])
+def test_the_whole_job_on_torch_is_differentiable(torch, method):
+    # associate (stamps: NumPy) -> align sim3 -> APE rmse + RPE mean, against
+    # central differences of the NumPy job.
+    rng = np.random.default_rng(5)
+    t_est = np.sort(rng.uniform(0.05, 0.75, 6))
+    ref = _traj(REF)
+
+    def job(est):
+        r, e = T.associate(ref_of(est), est, max_diff=0.03, method=method)
+        e, _ = T.align(e, r, method="sim3")
+        return T.ape(r, e).stats["rmse"] + T.rpe(r, e).stats["mean"]
+
+    def ref_of(est):
+        return ref if isinstance(est.positions, np.ndarray) else _traj(torch.tensor(REF))
+
+    est_pq = _pq(6, n=6)
+    x = torch.tensor(est_pq, requires_grad=True)
+    value = job(T.Trajectory(t_est, rk.Transform.from_pq(x)))
+    value.backward()
+
+    def f(pq):
+        return float(job(T.Trajectory(t_est, rk.Transform.from_pq(pq))))
+
+    assert float(value.detach()) == pytest.approx(f(est_pq), rel=1e-12)
+    np.testing.assert_allclose(
+        x.grad.numpy(), _central_differences(f, est_pq), rtol=1e-6, atol=1e-7
+    )
+
+
+def test_associate_and_ape_under_jax_jit(jnp):
+    import jax
+
+    t_est = STAMPS[::2] + 0.004
+    ref = _traj(REF)
+
+    def f(pq):
+        r, e = T.associate(
+            _traj(jnp.asarray(REF)), T.Trajectory(t_est, rk.Transform.from_pq(pq))
+        )
+        return T.ape(r, e, "full").stats["rmse"]
+
+    est_pq = _pq(7, n=len(t_est))
+    r, e = T.associate(ref, T.Trajectory(t_est, rk.Transform.from_pq(est_pq)))
+    want = T.ape(r, e, "full").stats["rmse"]
+    assert float(jax.jit(f)(jnp.asarray(est_pq))) == pytest.approx(want, rel=1e-12)
+    fd = _central_differences(
+        lambda pq: float(
+            T.ape(
+                *T.associate(ref, T.Trajectory(t_est, rk.Transform.from_pq(pq))), "full"
+            ).stats["rmse"]
+        ),
+        est_pq,
+    )
+    np.testing.assert_allclose(
+        np.asarray(jax.grad(f)(jnp.asarray(est_pq))), fd, rtol=1e-6, atol=1e-7
+    )

@@ -117,6 +117,14 @@ def associate(ref, est, max_diff=0.01, offset=0.0, method="nearest", max_gap=Non
     TimestampError
         A trajectory without stamps, or no pair at all (naming both time ranges).
 
+    Notes
+    -----
+    The pairs depend on the stamps' values, which are NumPy (never traced); the
+    poses are only gathered by the pairs' indices (``"interpolate"``: slerped),
+    in their own namespace. So poses on torch keep their graph, and under
+    ``jax.jit`` association works on traced poses with the stamps as constants
+    (a change of the stamps is a new trace).
+
     Examples
     --------
     >>> import numpy as np
