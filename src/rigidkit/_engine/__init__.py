@@ -11,7 +11,8 @@ compile code themselves (``tests/test_layers.py`` checks):
   ``rk.slerp``);
 * host loops compiled in the background: :func:`in_background` queues a build
   for the engine's one compile thread, which calls :func:`compile_scan` (the
-  sequential scan of a chain kernel) or :func:`compile_host_loop` (a function in
+  sequential scan of a chain kernel), :func:`compile_fold` (a running state and
+  sums, only the last kept) or :func:`compile_host_loop` (a function in
   numba's subset); :func:`run_split` splits a call over the idle cores, and
   :func:`numba_available` says whether any of this can happen;
 * shared state: :class:`Lock` (``threading.Lock``), for the layers above that
@@ -24,7 +25,13 @@ compile code themselves (``tests/test_layers.py`` checks):
 from threading import Lock  # for the layers above, which import no threading
 
 from .binding import rebind
-from .host_loops import compile_host_loop, compile_scan, idle_workers, run_split
+from .host_loops import (
+    compile_fold,
+    compile_host_loop,
+    compile_scan,
+    idle_workers,
+    run_split,
+)
 from .kernel import Helper, Kernel, helper, kernel, waiting_for_loops
 from .namespace import float_dtype_of, is_numpy, is_torch, namespace_of
 from .numba_backend import available as numba_available
@@ -36,6 +43,7 @@ __all__ = [
     "Kernel",
     "Lock",
     "cache_dir",
+    "compile_fold",
     "compile_host_loop",
     "compile_scan",
     "drain",

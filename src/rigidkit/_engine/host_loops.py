@@ -4,7 +4,9 @@ Two kinds of algorithm of the layers above need a compiled loop of their own:
 
 * a sequential scan (the running products of ``rk.kinematics``' integration):
   :func:`compile_scan` generates it from a ``chain`` kernel (the text of
-  :func:`.loop_source.scan_source`) and compiles it;
+  :func:`.loop_source.scan_source`) and compiles it; :func:`compile_fold`
+  likewise a fold that keeps only the last state and sums (IMU preintegration:
+  a window's product, bias Jacobians and covariance in one pass);
 * a plain Python function written in numba's subset (the Gram pass and 4x4
   Jacobi solve of the chordal mean, in ``functional/averaging.py``):
   :func:`compile_host_loop` compiles it for the signatures it declares.
@@ -25,10 +27,10 @@ a writable one, ``"rN:uint8"`` / ``"wN:int64"`` of another NumPy dtype,
 
 from __future__ import annotations
 
-from .loop_source import scan_source
+from .loop_source import fold_source, scan_source
 from .numba_backend import idle_workers, import_source, run_split
 
-__all__ = ["compile_host_loop", "compile_scan", "idle_workers", "run_split"]
+__all__ = ["compile_fold", "compile_host_loop", "compile_scan", "idle_workers", "run_split"]
 
 
 def _types(args, dtype):
@@ -98,3 +100,25 @@ def compile_scan(chain, dtype):
     )
     sig = types.void(types.int64, *_types(("r2", "r3", "w3"), dtype))
     return numba.njit([sig], cache=cache, nogil=True, error_model="numpy")(module.scan)
+
+
+def compile_fold(step, carried, summed, inputs, dtype):
+    """The compiled ``fold(x0, in0, ..., out)`` of a ``step`` helper for ``dtype``.
+
+    ``x0`` (n, carried + summed), each ``in_j`` (n, N, inputs[j]) and ``out`` (n,
+    carried + summed), C-contiguous: the running state and sums of
+    :func:`.loop_source.fold_source`, cached on disk next to the kernels' loops,
+    releasing the GIL (windows split over threads with :func:`run_split`).
+    Called from a build of :func:`.numba_backend.in_background`.
+    """
+    import numba
+    from numba import types
+
+    module, cache = import_source(
+        f"rigidkit_fold_{step.name}",
+        fold_source(step, carried, summed, tuple(inputs)),
+        f"<rigidkit fold {step.name}>",
+    )
+    codes = ("r2",) + ("r3",) * len(inputs) + ("w2",)
+    sig = types.void(*_types(codes, dtype))
+    return numba.njit([sig], cache=cache, nogil=True, error_model="numpy")(module.fold)

@@ -9,7 +9,9 @@ cache and compiles it. Nothing here imports numba: this is text.
 
 The same generator writes the scan of :func:`scan_source` (a running product of
 a ``chain`` kernel along the steps of each trajectory), which
-:func:`.host_loops.compile_scan` compiles.
+:func:`.host_loops.compile_scan` compiles, and the fold of :func:`fold_source` (a
+running state and running sums, only the last written), which
+:func:`.host_loops.compile_fold` compiles.
 """
 
 from __future__ import annotations
@@ -279,6 +281,44 @@ def scan_source(chain, width: int) -> str:
         + ")",
         *[f"            s{c} = r[{c}]" for c in w],
         *[f"            out[b, k + 1, {c}] = s{c}" for c in w],
+    ]
+    parts.append("\n\n" + "\n".join(lines) + "\n")
+    return "\n".join(parts)
+
+
+def fold_source(step, carried: int, summed: int, inputs) -> str:
+    """The module of ``fold(x0, in0, in1, ..., out)``: a running state and sums.
+
+    For every trajectory ``b``: the state ``s = x0[b, :carried]`` and the sums
+    ``a = x0[b, carried:]``; for each step ``k``, ``r = step(*s, *in0[b, k],
+    *in1[b, k], ...)``, then ``s = r[:carried]`` and ``a += r[carried:]``; at the
+    end ``out[b] = (s, a)``. ``step`` is a helper or kernel of scalars (inlined)
+    returning ``carried + summed`` numbers; ``inputs`` are the widths of the
+    per-step arrays ``(n, N, width)``. Nothing per step is written: a window's
+    running product and the sums over its steps in one pass, in registers.
+    """
+    fns = [*step.dependencies(), step]
+    parts = [NUMBA_PRELUDE]
+    for f in fns:
+        parts.append(
+            "\n\n@numba.njit(inline='always', error_model='numpy')\n"
+            + function_source(f.fn)
+        )
+    names = [f"in{j}" for j in range(len(inputs))]
+    args = [f"{name}[b, k, {c}]" for name, w in zip(names, inputs) for c in range(w)]
+    state = [f"s{c}" for c in range(carried)]
+    lines = [
+        f"def fold(x0, {', '.join(names)}, out):",
+        "    n, steps = in0.shape[0], in0.shape[1]",
+        "    for b in range(n):",
+        *[f"        s{c} = x0[b, {c}]" for c in range(carried)],
+        *[f"        a{c} = x0[b, {carried + c}]" for c in range(summed)],
+        "        for k in range(steps):",
+        f"            r = {step.name}({', '.join(state + args)})",
+        *[f"            s{c} = r[{c}]" for c in range(carried)],
+        *[f"            a{c} += r[{carried + c}]" for c in range(summed)],
+        *[f"        out[b, {c}] = s{c}" for c in range(carried)],
+        *[f"        out[b, {carried + c}] = a{c}" for c in range(summed)],
     ]
     parts.append("\n\n" + "\n".join(lines) + "\n")
     return "\n".join(parts)
