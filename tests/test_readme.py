@@ -8,6 +8,7 @@ import re
 import sys
 
 import numpy as np
+import pytest
 import scipy.linalg as sl
 from scipy.spatial.transform import Rotation as SciRot
 
@@ -110,3 +111,103 @@ def test_the_project_cites_no_document_it_does_not_hold():
     ]
     assert found == []
     assert (root / "docs" / "errata.md").is_file()
+
+
+def _section(title: str) -> str:
+    """The README's text from the heading ``title`` to the next heading of any level."""
+    text = README.read_text()
+    start = text.index(f"\n{title}\n")
+    nxt = re.search(r"\n#{2,3} ", text[start + len(title) + 2 :])
+    return text[start : start + len(title) + 2 + (nxt.start() if nxt else len(text))]
+
+
+def test_the_first_screen_shows_install_a_first_result_and_the_quaternion_order():
+    first = "\n".join(README.read_text().splitlines()[:50])
+    assert "pip install -e . && .venv/bin/rigidkit convert" in first
+    assert 'pip install -e ".[test]" && .venv/bin/python -m pytest' in first
+    assert "```python" in first and "as_quat()" in first
+    assert "`(w, x, y, z)`" in first and "scalar_first=False" in first
+    assert "wrong rotation and no" in first
+    assert "docs/conventions.md" in README.read_text()
+
+
+def test_coming_from_ros_the_wrong_order_is_visible():
+    """The ROS example: (x, y, z, w) read with scalar_first=False is scipy's rotation
+    (scipy reads (x, y, z, w) by default) and tf's roll-pitch-yaw; read as (w, x, y,
+    z) it is another rotation, silently."""
+    ns: dict = {}
+    exec("import numpy as np\nimport rigidkit as rk\n", ns)
+    (block,) = re.findall(r"```python\n(.*?)```", _section("### Coming from ROS"), re.S)
+    exec(block, ns)
+    q = np.asarray(ns["orientation_xyzw"])
+    ref = SciRot.from_quat(q)  # scipy: scalar last
+    np.testing.assert_allclose(ns["W_R_B"].as_matrix(), ref.as_matrix(), atol=1e-15)
+    assert not np.allclose(ns["wrong"].as_matrix(), ref.as_matrix(), atol=0.1)
+    np.testing.assert_allclose(float(ns["wrong"].angle), np.pi, atol=1e-6)
+    np.testing.assert_allclose(ref.magnitude(), np.pi / 4, atol=1e-6)
+    # tf's euler_from_quaternion (axes="sxyz"), by hand for a turn about z only:
+    x, y, z, w = q / np.linalg.norm(q)
+    yaw = np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+    np.testing.assert_allclose(
+        [ns["roll"], ns["pitch"], ns["yaw"]], [0.0, 0.0, yaw], atol=1e-12
+    )
+    np.testing.assert_allclose(ns["back"][:3], ns["position"], atol=1e-15)
+    np.testing.assert_allclose(ns["back"][3:], q / np.linalg.norm(q), atol=1e-15)
+
+
+def test_coming_from_scipy_examples_agree_with_scipy():
+    ns: dict = {}
+    exec("import numpy as np\nimport rigidkit as rk\n", ns)
+    (block,) = re.findall(r"```python\n(.*?)```", _section("### Coming from scipy"), re.S)
+    exec(block, ns)
+    S1, S2 = ns["S1"], ns["S2"]
+    np.testing.assert_allclose(ns["R12"].as_matrix(), (S1 * S2).as_matrix(), atol=1e-15)
+    np.testing.assert_allclose(ns["q_rk"], np.roll(ns["q_scipy"], 1), atol=1e-15)
+    assert ns["same"].approx_equal(ns["R1"], atol=1e-15)
+    np.testing.assert_allclose(ns["rates"], np.tile([0.0, 0.0, 0.2], (5, 1)), atol=1e-12)
+    assert ns["batch"].shape == (100,)
+
+
+def test_the_coming_from_table_holds():
+    """Each row of the table, against scipy and hand-derived products."""
+    from scipy.spatial.transform import RigidTransform
+
+    import rigidkit as rk
+
+    table = _section("### Coming from ROS / scipy / tf / Eigen")
+    for row in ("quaternion in", "quaternion out", "roll-pitch-yaw", "angles back",
+                "twist / exp coordinates", "composition", "random"):  # fmt: skip
+        assert f"| {row} |" in table
+    roll, pitch, yaw = 0.3, -0.2, 1.1
+    R = rk.Rotation.from_euler("xyz", [roll, pitch, yaw])
+
+    def about(axis, a):  # elementary rotation matrices, by hand
+        c, s = np.cos(a), np.sin(a)
+        i, j = [(1, 2), (2, 0), (0, 1)][axis]
+        m = np.eye(3)
+        m[i, i], m[i, j], m[j, i], m[j, j] = c, -s, s, c
+        return m
+
+    Rz_Ry_Rx = about(2, yaw) @ about(1, pitch) @ about(0, roll)  # ROS setRPY, Eigen
+    np.testing.assert_allclose(R.as_matrix(), Rz_Ry_Rx, atol=1e-15)
+    assert R.approx_equal(rk.Rotation.from_euler("ZYX", [yaw, pitch, roll]), atol=1e-15)
+    np.testing.assert_allclose(R.as_euler("xyz"), [roll, pitch, yaw], atol=1e-14)
+    np.testing.assert_allclose(R.as_euler("ZYX"), [yaw, pitch, roll], atol=1e-14)
+    np.testing.assert_allclose(
+        R.as_quat(scalar_first=False), SciRot.from_matrix(Rz_Ry_Rx).as_quat(), atol=1e-15
+    )
+    # Twists: ours (v, w), scipy's exponential coordinates (w, v).
+    v, w = np.array([0.1, -0.4, 0.2]), np.array([0.3, 0.2, -0.5])
+    sci = RigidTransform.from_exp_coords(np.concatenate([w, v]))
+    np.testing.assert_allclose(
+        rk.Transform.exp(np.concatenate([v, w])).as_matrix(), sci.as_matrix(), atol=1e-15
+    )
+    np.testing.assert_allclose(
+        rk.Transform.from_exp_coords(np.concatenate([w, v])).as_matrix(),
+        sci.as_matrix(),
+        atol=1e-15,
+    )
+    # R1 * R2 is refused (scipy's composition is @ here).
+    with pytest.raises(TypeError):
+        R * R
+    assert rk.Rotation.random(3, rng=0).approx_equal(rk.Rotation.random(3, rng=0)).all()
