@@ -149,3 +149,98 @@ def test_interpolators_on_torch_keep_the_graph(keys, torch):
     assert np.allclose(
         spline(q.detach()).as_quat().numpy(), spline(qn).as_quat(), atol=1e-14
     )
+
+
+# -- kinematics -------------------------------------------------------------------------
+
+
+@pytest.fixture
+def samples():
+    rng = np.random.default_rng(11)
+    times = np.cumsum(rng.uniform(0.05, 0.15, 7))
+    rotations = rk.Rotation.from_rotvec(np.cumsum(rng.normal(scale=0.2, size=(7, 3)), 0))
+    transforms = rk.Transform.exp(np.cumsum(rng.normal(scale=0.2, size=(7, 6)), 0))
+    omega = rng.normal(size=(7, 3))
+    return times, rotations, transforms, omega
+
+
+def _kinematics(times, rotations, transforms, omega):
+    """name -> (function of one array argument, its NumPy value)."""
+    kin = rk.kinematics
+    steps = np.diff(times, append=times[-1] + 0.1)
+    return {
+        "angular_velocity_from_samples": (
+            lambda t: kin.angular_velocity_from_samples(rotations, t, frame="body"),
+            times,
+        ),
+        "twist_from_samples": (
+            lambda t: kin.twist_from_samples(transforms, t, frame="world"),
+            times,
+        ),
+        "twist_from_screw": (
+            lambda u: kin.twist_from_screw(omega[0], u, 0.3, 1.2),
+            omega[1:4],
+        ),
+        "integrate_angular_velocity-rk4-float-dt": (
+            lambda w: kin.integrate_angular_velocity(
+                rotations[0], w, 0.01, frame="body", method="rk4"
+            ).as_quat(),
+            omega,
+        ),
+        "integrate_angular_velocity-rk4-steps": (
+            lambda h: kin.integrate_angular_velocity(
+                rotations[0], omega, h, frame="world", method="rk4"
+            ).as_quat(),
+            steps,
+        ),
+        "integrate_twist-midpoint-steps": (
+            lambda h: kin.integrate_twist(
+                transforms[0],
+                np.concatenate([omega, omega], -1),
+                h,
+                frame="body",
+                method="midpoint",
+            ).as_matrix(),
+            steps,
+        ),  # fmt: skip
+    }
+
+
+KINEMATICS = [
+    "angular_velocity_from_samples",
+    "twist_from_samples",
+    "twist_from_screw",
+    "integrate_angular_velocity-rk4-float-dt",
+    "integrate_angular_velocity-rk4-steps",
+    "integrate_twist-midpoint-steps",
+]
+
+
+@pytest.mark.parametrize("name", KINEMATICS)
+def test_kinematics_trace_under_jit(name, samples, jax, jnp, validation):
+    """``bool()`` of traced times, directions and steps; steps turned into NumPy."""
+    fn, x = _kinematics(*samples)[name]
+    out = jax.jit(fn)(jnp.asarray(x))
+    assert np.allclose(np.asarray(out), fn(x), rtol=0, atol=1e-12)
+
+
+def test_rk4_gradient_in_the_steps(samples, jax, jnp):
+    """Non-uniform steps now carry gradients (the weights were NumPy constants)."""
+    fn, h = _kinematics(*samples)["integrate_angular_velocity-rk4-steps"]
+    dh = np.zeros_like(h)
+    dh[2] = 1.0
+    g = jax.grad(lambda s: fn(s)[-1, 1])(jnp.asarray(h))
+    eps = 1e-6
+    fd = (fn(h + eps * dh)[-1, 1] - fn(h - eps * dh)[-1, 1]) / (2 * eps)
+    assert np.isclose(float(g[2]), fd, rtol=1e-6, atol=1e-9)
+
+
+@pytest.mark.parametrize("name", ["angular_velocity_from_samples", "twist_from_screw"])
+def test_kinematics_value_checks_still_raise(name, samples):
+    """The checks that moved stay: non-increasing times, a zero screw direction."""
+    fn, x = _kinematics(*samples)[name]
+    x = x.copy()
+    x[2] = x[1] if name.startswith("angular") else 0.0
+    err = rk.DegenerateInputError if name.startswith("angular") else rk.ZeroNormError
+    with pytest.raises(err, match=r"\(1,\)" if name.startswith("angular") else r"\(2,\)"):
+        fn(x)

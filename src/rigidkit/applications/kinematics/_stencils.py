@@ -9,8 +9,8 @@ itself, which the interpolation returns exactly (its weight is 1, the others 0).
 
 Node times are formed relative to ``t_k`` from the few step durations between
 them, not as differences of absolute times, so long logs lose no digits.
-The weights are computed on the host in float64 (NumPy) and applied in the
-rates' own namespace (gradients flow with respect to the rates, not ``dt``).
+The weights are computed from the steps in their own namespace (float64 on
+NumPy) and applied to the rates, so both trace and carry gradients.
 """
 
 from __future__ import annotations
@@ -18,48 +18,70 @@ from __future__ import annotations
 import numpy as np
 
 from ..._engine.namespace import device_of, is_numpy, namespace_of
-from ..._validate import to_numpy
+from ..._validate import raise_where
 from ...errors import DegenerateInputError
 
 
-def _node_offsets(d, m: int):
-    """``t_{j0(k) + i} - t_k`` for ``i < m``, from the step durations ``d`` (..., N)."""
+def _node_offsets(d, m: int, xp=np):
+    """``t_{j0(k) + i} - t_k`` for ``i < m``, from the step durations ``d`` (..., N).
+
+    Sums of a few consecutive durations, formed by slicing in the namespace ``xp``
+    of ``d`` (they trace, and carry gradients in ``d``); ``j0`` (the first node of
+    each step's window) depends on the shapes only and is NumPy.
+    """
     n = d.shape[-1]
     k = np.arange(n)
     j0 = np.clip(k - (m // 2 - 1), 0, n - m)
-    pad = np.zeros(d.shape[:-1] + (m,))
-    p = np.concatenate([pad, d, pad], axis=-1)  # p[..., k + m + l] = d_{k+l}
+    lead = tuple(d.shape[:-1])
+    pad = xp.zeros(lead + (m,), dtype=d.dtype, device=device_of(d))
+    p = xp.concat([pad, d, pad], axis=-1)  # p[..., k + m + l] = d_{k+l}
     # offset(k, s) for s = j - k in [-(m-1), m-1], column s + m - 1
     cols = [None] * (2 * m - 1)
-    cols[m - 1] = np.zeros(d.shape)
+    cols[m - 1] = 0.0 * d
     for s in range(1, m):
-        cols[m - 1 + s] = cols[m - 2 + s] + p[..., k + m + s - 1]
-        cols[m - 1 - s] = cols[m - s] - p[..., k + m - s]
-    table = np.stack(cols, axis=-1)
-    s_idx = (j0[:, None] + np.arange(m)[None, :]) - k[:, None] + (m - 1)  # (N, m)
-    offs = np.take_along_axis(table, np.broadcast_to(s_idx, table.shape[:-1] + (m,)), -1)
-    return j0, offs
+        cols[m - 1 + s] = cols[m - 2 + s] + p[..., m + s - 1 : m + s - 1 + n]
+        cols[m - 1 - s] = cols[m - s] - p[..., m - s : m - s + n]
+    # column j0(k) + i - k of row k: a fixed (shape-only) selection
+    shift = j0 - k + (m - 1)  # (N,), the column of node i = 0
+    offs = []
+    for i in range(m):
+        col = 0.0 * d
+        for c in np.unique(shift + i):
+            mask = np.asarray(shift + i == c, dtype=np.float64)
+            col = col + _const(xp, mask, d) * cols[c]
+        offs.append(col)
+    return j0, xp.stack(offs, axis=-1)
 
 
-def _lagrange(offs, x):
+def _const(xp, a, like):
+    if is_numpy(xp):
+        return np.asarray(a, dtype=like.dtype)
+    return xp.asarray(a, dtype=like.dtype, device=device_of(like))
+
+
+def _lagrange(offs, x, xp=np):
     """Weights ``L_i(x)`` of the nodes ``offs`` (..., N, m) at ``x`` (..., N)."""
     m = offs.shape[-1]
     w = []
     for i in range(m):
-        num = np.ones(offs.shape[:-1])
-        den = np.ones(offs.shape[:-1])
+        num = 1.0
+        den = 1.0
         for j in range(m):
             if j != i:
                 num = num * (x - offs[..., j])
                 den = den * (offs[..., i] - offs[..., j])
         w.append(num / den)
-    return np.stack(w, axis=-1)
+    return xp.stack(w, axis=-1)
 
 
 def rates_at_step_points(rate, h, *, order: int):
     """Rates at the middle and the end of every step, shape of ``rate`` (..., N, W).
 
-    ``h`` is the step duration, shape () (uniform) or (..., N).
+    ``h`` is the step duration, shape () (uniform) or (..., N), a number or an
+    array (NumPy, or of the rates' namespace): uniform steps need no values of
+    ``h`` (the weights do not change when all steps scale alike); non-uniform
+    weights are computed from ``h`` in its namespace (in float64 on NumPy), so
+    they trace under ``jax.jit`` and ``torch.compile`` and carry gradients in ``h``.
     """
     n = rate.shape[-2]
     m = 2 if order == 2 else 4
@@ -68,7 +90,8 @@ def rates_at_step_points(rate, h, *, order: int):
             f"the {'midpoint' if m == 2 else 'rk4'} method needs at least {m} samples "
             f"to interpolate the rate, got {n} (use method='exact')"
         )
-    hh = to_numpy(h).astype(np.float64)
+    if isinstance(h, (int, float)):
+        h = np.asarray(h, dtype=np.float64)
     xp = namespace_of(rate)
     numpy = is_numpy(xp)
 
@@ -84,15 +107,22 @@ def rates_at_step_points(rate, h, *, order: int):
             else rate[..., xp.asarray(idx, device=device_of(rate)), :]
         )
 
-    if hh.ndim == 0 and n > m:
+    if h.ndim == 0 and n > m:
         return _uniform(rate, n, m, conv, rows, xp)
-    # Lagrange weights do not change when all steps scale alike.
-    d = np.ones(n) if hh.ndim == 0 else hh
-    if np.any(d <= 0):
-        raise DegenerateInputError("step durations dt must be positive")
-    j0, offs = _node_offsets(d, m)
-    w_mid = conv(_lagrange(offs, 0.5 * d))
-    w_end = conv(_lagrange(offs, d))
+    if h.ndim == 0:  # uniform, n == m: unit steps give the same weights
+        d = np.ones(n)
+        hx = np
+    elif isinstance(h, np.ndarray):
+        d = h.astype(np.float64)
+        hx = np
+    else:
+        d = h
+        hx = namespace_of(h)
+    # skipped under tracing and with set_validation(False); on Dask at compute time
+    raise_where(d <= 0, DegenerateInputError, "step durations dt must be positive {where}")
+    j0, offs = _node_offsets(d, m, hx)
+    w_mid = conv(_lagrange(offs, 0.5 * d, hx))
+    w_end = conv(_lagrange(offs, d, hx))
     mid = 0.0
     end = 0.0
     for i in range(m):

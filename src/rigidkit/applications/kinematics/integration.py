@@ -34,9 +34,11 @@ from functools import partial
 
 import numpy as np
 
+from ..._engine import dask_backend
 from ..._engine.namespace import device_of, is_numpy, namespace_of
 from ..._validate import finite_array
 from ...errors import ShapeError
+from ...functional.interpolation import meet
 from ...objects import registry
 from ...objects.rotation import Rotation
 from ...objects.transform import Transform
@@ -56,20 +58,33 @@ def _method(method, fn):
 
 
 def _steps(dt, rate, fn):
-    """Step durations as an array of the rate's namespace, shape () or (..., N)."""
+    """Step durations, shape () or (..., N), of the namespace of the rates or ``dt``."""
+    return _rates_and_steps(dt, rate, fn)[1]
+
+
+def _rates_and_steps(dt, rate, fn):
+    """Rates and step durations of one namespace, the steps of shape () or (..., N).
+
+    The steps stay in the caller's namespace: NumPy rates meet JAX, torch or Dask
+    steps (a traced ``dt`` under ``jax.jit`` stays traced, a Python float is a
+    constant of the rates' namespace).
+    """
     n = rate.shape[-2]
-    xp = namespace_of(rate)
     h = finite_array(dt, (), "dt")
     if h.ndim and h.shape[-1] != n:
         raise ShapeError(
             f"{fn}: dt has {h.shape[-1]} step times on its last axis, the rates {n} "
             f"samples (one step per sample; pass a scalar for uniform steps)"
         )
-    if is_numpy(xp):
+    rate = meet(rate, h)
+    xp = namespace_of(rate)
+    if is_numpy(xp) and not dask_backend.is_dask(h):
         h = np.asarray(h, dtype=rate.dtype)
+    elif is_numpy(xp):
+        h = h.astype(rate.dtype)
     else:
         h = xp.asarray(h, dtype=rate.dtype, device=device_of(rate))
-    return h
+    return rate, h
 
 
 def _increments(one, rk4, method, rate, h):
@@ -101,7 +116,7 @@ def integrate(X0, rate, dt, method, fn, body=0):
         rk4 = partial(rk4, body)
     _method(method, fn)
     r = _samples(rate, spec.dof, spec.rate, fn)
-    h = _steps(dt, r, fn)
+    r, h = _rates_and_steps(dt, r, fn)
     x0 = _like(registry.stored(X0), r)
     if chain is None:
         tau = _scan.running_sum(_increments(one, rk4, method, r, h))

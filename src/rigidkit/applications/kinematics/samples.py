@@ -25,8 +25,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._engine.namespace import device_of, is_numpy, namespace_of
-from ..._validate import finite_array
+from ..._engine.namespace import device_of, is_numpy, is_torch, namespace_of
+from ..._validate import finite_array, raise_unless
 from ...errors import DegenerateInputError, ShapeError
 from ...objects.registry import stored
 from ...objects.rotation import Rotation
@@ -43,16 +43,33 @@ def _times(times, n, like, fn):
             f"{fn}: times must have shape (..., {n}), one per sample; got {t.shape}"
         )
     xp = namespace_of(like)
-    if is_numpy(xp):
+    if isinstance(t, np.ndarray) and is_numpy(xp):
         t = np.asarray(t, dtype=np.result_type(t.dtype, like.dtype, np.float32))
+    elif is_numpy(xp):  # NumPy samples, times of another namespace: kept there
+        t = _floating(t, like)
     else:
         t = xp.asarray(t, dtype=like.dtype, device=device_of(like))
     h = t[..., 1:] - t[..., :-1]
-    if not bool(namespace_of(h).all(h > 0)):
-        raise DegenerateInputError(
-            f"{fn}: times must increase strictly from sample to sample"
-        )
+    # Read only where values can be read (skipped under tracing and with
+    # set_validation(False); at compute time on Dask).
+    raise_unless(
+        h > 0,
+        DegenerateInputError,
+        f"{fn}: times must increase strictly from sample to sample; the step "
+        "{where} is not positive",
+    )
     return h
+
+
+def _floating(t, like):
+    """Times ``t`` (JAX, torch, Dask) as floats of at least the precision of ``like``."""
+    if is_torch(t):
+        import torch
+
+        f64 = t.dtype == torch.float64 or like.dtype == np.float64
+        return t.to(torch.float64 if f64 else torch.float32)
+    kind = np.result_type(np.dtype(t.dtype), like.dtype, np.float32)
+    return t if t.dtype == kind else t.astype(kind)
 
 
 def _combine(d, h, xp, second=None, before_last=None):
