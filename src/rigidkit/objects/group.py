@@ -132,6 +132,30 @@ class Group(ABC):
         )
 
     @classmethod
+    def __torch_function__(cls, func, types, args=(), kwargs=None):
+        """``X @ tensor`` inside ``torch.compile``; nothing anywhere else.
+
+        TorchDynamo (torch 2.13) does not call ``__matmul__`` for an ``@`` whose
+        other operand is a tensor: it makes it torch's ``matmul`` and, since an
+        object is no graph value, fails ("Missing as_proxy() implementation")
+        unless an operand has this protocol, which it then calls with the
+        operands swapped to put the tensor first: ``(p, X)``. So while compiling,
+        ``(p, X)`` under ``matmul`` is ``X @ p`` (``X.__matmul__(p)``, traced as
+        ``X.apply(p)``). Dynamo swaps ``p @ X`` the same way, so a compiled
+        ``p @ X`` gives ``X @ p`` too, where eager code raises ``TypeError``
+        (``tests/test_torch_matmul.py`` holds both). Eager, every torch function
+        of an object returns ``NotImplemented`` here: ``p @ X`` reaches
+        :meth:`__rmatmul__` as before.
+        """
+        if not kwargs and len(args) == 2 and isinstance(args[1], Group):
+            import torch
+
+            if func in (torch._C.TensorBase.matmul, torch.Tensor.__matmul__):
+                if torch.compiler.is_compiling() and not isinstance(args[0], Group):
+                    return args[1].__matmul__(args[0])
+        return NotImplemented
+
+    @classmethod
     def include(cls, x):
         """``x`` as an element of this kind: ``x`` itself, or of a kind included in it.
 
