@@ -317,6 +317,46 @@ def test_parser_reports_the_first_problem(engine):
     assert data.tolist() == [[1.0, 2.0, 3.0]]
 
 
+@pytest.mark.parametrize("threads", ["2", "3", "7"])
+def test_parser_in_parts_equals_one_pass(monkeypatch, threads):
+    # A file parsed in parts (one per thread) gives the rows, the lines, the
+    # slow tokens and the first error of the one-pass parse, wherever it is.
+    from rigidkit.applications.io import _parse
+
+    rng = np.random.default_rng(8)
+    rows = []
+    for k in range(300):
+        v = rng.normal(size=4) * 10.0 ** rng.integers(-5, 5, 4)
+        kind = k % 7
+        if kind == 0:
+            rows.append("# a comment line")
+        elif kind == 1:
+            rows.append("")
+        tokens = [repr(float(x)) if kind == 2 else f"{x:.9f}" for x in v]
+        rows.append(" ".join(tokens) + (" # trailing" if kind == 3 else ""))
+    text = "\r\n".join(rows[:150]) + "\r\n" + "\n".join(rows[150:]) + "\n"
+    one = _parse_python(text.encode(), 4, True, None)
+    monkeypatch.setattr(_parse, "PARALLEL_MIN", 0)
+    monkeypatch.setenv("RIGIDKIT_NUM_THREADS", threads)
+    assert len(_parse._parts(text.encode(), int(threads))) == int(threads)
+    got = parse_table(text.encode(), 4, True, None, engine="numba")
+    assert got[2:] == ("ok", 0, 0)
+    np.testing.assert_array_equal(got[0], one[0])
+    np.testing.assert_array_equal(got[1], one[1])
+    lines = text.encode().split(b"\n")
+    for at, bad, expected in [
+        (len(lines) - 40, b"1 2 3", ("count", 3)),
+        (len(lines) // 2 + 3, b"1 2 x 4", ("token", 3)),
+        (len(lines) - 3, b"1 2 3 1" + b"0" * 30 + b"x", ("token", 4)),
+    ]:
+        broken = b"\n".join(lines[:at] + [bad] + lines[at + 1 :])
+        want = _parse_python(broken, 4, True, None)
+        got = parse_table(broken, 4, True, None, engine="numba")
+        assert got[2:] == want[2:] == (expected[0], at + 1, expected[1])
+        np.testing.assert_array_equal(got[0], want[0])
+        np.testing.assert_array_equal(got[1], want[1])
+
+
 def test_reader_is_not_np_loadtxt_slow(tmp_path):
     # Not a timing test: the reader must give what np.loadtxt gives.
     traj = _traj(2000)

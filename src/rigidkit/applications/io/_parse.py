@@ -18,12 +18,21 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._engine import compile_host_loop, in_background, numba_available
+from ..._engine import (
+    compile_host_loop,
+    idle_workers,
+    in_background,
+    numba_available,
+    run_split,
+)
 
 __all__ = ["parse_table"]
 
 # Status codes of the loop.
 OK, BAD_COUNT, BAD_TOKEN = 0, 1, 2
+# From this many bytes a file is parsed in parts, one per idle core (a part
+# starts a thread and its values are copied once more, ~0.1 ms a megabyte).
+PARALLEL_MIN = 1 << 20
 
 _POW10 = np.array([10.0**k for k in range(23)])
 _JOB = None
@@ -207,6 +216,7 @@ def _build():
         ("r1:uint8", "int", "bool", "int", "r1", "w2", "w1:int64", "w2:int64"),
         dtypes=("float64",),
         returns=("int", "int", "int", "int", "int"),
+        nogil=True,  # a large file's parts parse at once on idle cores
     )
 
 
@@ -249,42 +259,84 @@ def parse_table(data: bytes, ncols: int, exact: bool, delimiter, engine="auto"):
             return parsed
         if _job() is None:
             return _parse_python(data, ncols, exact, delimiter)
-    buf = np.frombuffer(data, dtype=np.uint8)
-    # A row takes at least 2 ncols bytes ("1 2 3\n"): a bound on the rows that
-    # costs no pass over the data (np.empty's untouched pages cost nothing).
-    rows = (len(data) + 1) // (2 * ncols) + 1
-    out = np.empty((rows, ncols))
-    lines = np.empty(rows, dtype=np.int64)
-    # Tokens off the fast path are rare in files written with up to 16 digits; a
-    # file full of them (17-digit round-trip output) is parsed twice.
-    slow = np.empty((min(rows * ncols, max(4096, rows * ncols // 16)), 5), dtype=np.int64)
-    delim = 0 if delimiter is None else ord(delimiter)
     job = _job()
     if job is None:
         return _parse_python(data, ncols, exact, delimiter)
     loop = job.result()
-    while True:
-        status, nrows, line, field, nslow = loop(
-            buf, ncols, exact, delim, _POW10, out, lines, slow
-        )
-        if nslow <= len(slow):
+    buf = np.frombuffer(data, dtype=np.uint8)
+    delim = 0 if delimiter is None else ord(delimiter)
+    parts = _parts(data, idle_workers() if len(data) >= PARALLEL_MIN else 1)
+    done = run_split(
+        lambda k, _: _parse_part(loop, buf[slice(*parts[k])], ncols, exact, delim),
+        len(parts),
+        len(parts),
+        lambda start, stop: (start, stop),
+    )
+    # The parts' rows, lines and slow tokens in the whole file's numbering, up to
+    # the first part that stops at an error.
+    outs, numbers, slows = [], [], []
+    row0 = newlines = prev = 0
+    status, line, field = OK, 0, 0
+    for (start, _), result in zip(parts, done):
+        status, nrows, line, field, part_out, part_lines, slow = result
+        newlines += data.count(b"\n", prev, start)  # the lines before the part
+        prev = start
+        outs.append(part_out[:nrows])
+        numbers.append(part_lines[:nrows] + newlines)
+        slow[:, 0] += row0
+        slow[:, 2:4] += start
+        slow[:, 4] += newlines
+        slows.append(slow)
+        row0 += nrows
+        line += newlines
+        if status != OK:
             break
-        slow = np.empty((nslow, 5), dtype=np.int64)
-    if nslow:
-        bad = _convert_slow(buf, data, slow[:nslow], out)
+    out = outs[0] if len(outs) == 1 else np.concatenate(outs)
+    lines = numbers[0] if len(numbers) == 1 else np.concatenate(numbers)
+    slow = slows[0] if len(slows) == 1 else np.concatenate(slows)
+    if len(slow):
+        bad = _convert_slow(buf, data, slow, out)
         if bad is not None:
             r, c, ln = bad
             if status == OK or ln < line or (ln == line and c + 1 < field):
                 return out[:r], lines[:r], "token", ln, c + 1
     if status != OK:
-        return (
-            out[:nrows],
-            lines[:nrows],
-            "count" if status == BAD_COUNT else "token",
-            line,
-            field,
+        kind = "count" if status == BAD_COUNT else "token"
+        return out, lines, kind, line, field
+    return out, lines, "ok", 0, 0
+
+
+def _parts(data, workers):
+    """``workers`` byte ranges ``(start, stop)`` of ``data`` that begin at line
+    starts (a line is never split), fewer where lines are long."""
+    cuts = [0]
+    for k in range(1, workers):
+        at = data.find(b"\n", len(data) * k // workers)
+        at = len(data) if at < 0 else at + 1
+        if cuts[-1] < at < len(data):
+            cuts.append(at)
+    cuts.append(len(data))
+    return list(zip(cuts[:-1], cuts[1:]))
+
+
+def _parse_part(loop, buf, ncols, exact, delim):
+    """The compiled loop on the bytes ``buf``: ``(status, rows, line, field,
+    values, lines, slow)``, lines and positions counted from the part's start."""
+    # A row takes at least 2 ncols bytes ("1 2 3\n"): a bound on the rows that
+    # costs no pass over the data (np.empty's untouched pages cost nothing).
+    rows = (len(buf) + 1) // (2 * ncols) + 1
+    out = np.empty((rows, ncols))
+    lines = np.empty(rows, dtype=np.int64)
+    # Tokens off the fast path are rare in files written with up to 16 digits; a
+    # file full of them (17-digit round-trip output) is parsed twice.
+    slow = np.empty((min(rows * ncols, max(4096, rows * ncols // 16)), 5), dtype=np.int64)
+    while True:
+        status, nrows, line, field, nslow = loop(
+            buf, ncols, exact, delim, _POW10, out, lines, slow
         )
-    return out[:nrows], lines[:nrows], "ok", 0, 0
+        if nslow <= len(slow):
+            return status, nrows, line, field, out, lines, slow[:nslow]
+        slow = np.empty((nslow, 5), dtype=np.int64)
 
 
 def _convert_slow(buf, data, slow, out):
