@@ -12,6 +12,8 @@ exponential coords    scipy's ``RigidTransform``: ``(w, v)``, rotation first; th
                       numbers as our twist ``(v, w)`` in the other order
 pq                    pytransform3d's pose vector ``(tx, ty, tz, qw, qx, qy, qz)``;
                       ``_xyzw``: TUM/ROS ``(tx, ty, tz, qx, qy, qz, qw)``
+xyzw quaternion       scipy's and ROS's scalar-last ``(x, y, z, w)``, read (normalised)
+                      and written in one pass each
 ====================  ==================================================================
 
 Dual quaternions: a pose is the unit dual quaternion with real part ``q_r = q``
@@ -113,3 +115,16 @@ def pq_from_pose(w, x, y, z, tx, ty, tz):
 def pq_xyzw_from_pose(w, x, y, z, tx, ty, tz):
     """TUM/ROS ``(tx, ty, tz, qx, qy, qz, qw)`` of a pose."""
     return (tx, ty, tz, x, y, z, w)
+
+
+@kernel(inputs=[(4,)], outputs=[(4,), ()])
+def quat_from_xyzw(qx, qy, qz, qw):
+    """Unit ``(w, x, y, z)`` of a scalar-last ``(x, y, z, w)`` (scipy, ROS), and the
+    norm of the input (0 or not finite: no rotation), in one pass."""
+    return quat_normalize(qw, qx, qy, qz)
+
+
+@kernel(inputs=[(4,)], outputs=[(4,)])
+def xyzw_from_quat(w, x, y, z):
+    """Scalar-last ``(x, y, z, w)`` (scipy, ROS) of a quaternion ``(w, x, y, z)``."""
+    return (x, y, z, w)
