@@ -31,7 +31,6 @@ import os
 import sys
 import threading
 
-from . import compile_warnings
 from .loop_source import SINGLE, loop_options, module_source
 
 __all__ = [
@@ -342,11 +341,13 @@ def drain(timeout=None) -> bool:
 
 def _work():
     # numba's warning filters and recordings kept on this thread (see compile_warnings).
+    from . import compile_warnings
+
     with compile_warnings.isolate():
-        _serve()
+        _serve(compile_warnings)
 
 
-def _serve():
+def _serve(compile_warnings):
     global _AVAILABLE
     # Before numba's first import: no colorama in its error messages (see _plain_errors).
     os.environ.setdefault("NUMBA_DISABLE_ERROR_MESSAGE_HIGHLIGHTING", "1")
