@@ -255,9 +255,18 @@ def raise_unless(ok, error, message) -> None:
 
 
 def as_array(x, trail: tuple, what: str):
-    """``x`` as an array of its own namespace (NumPy for lists), shape-checked."""
+    """``x`` as an array of its own namespace (NumPy for lists), shape-checked.
+
+    An object that stands for matrices (a ``rigidkit.Rotation``, scipy's
+    ``Rotation`` or ``RigidTransform``, ...) is read as its matrices where square
+    matrices of its size are expected, and a scipy ``Rotation`` as its quaternions
+    ``(w, x, y, z)`` where quaternions are (:func:`object_array`); any other object
+    is a :class:`ShapeError` that says what to pass instead.
+    """
     if type(x) is not np.ndarray and is_numpy(namespace_of(x)):
-        if dask_backend.is_dask(x):  # kept lazy: the engine maps kernels over chunks
+        if type(x) not in _PLAIN and hasattr(x, "as_matrix"):
+            x = object_array(x, trail, what)
+        elif dask_backend.is_dask(x):  # kept lazy: the engine maps kernels over chunks
             if x.dtype.kind not in "fiu":
                 raise ShapeError(f"{what}: expected real numbers, got dtype {x.dtype}")
         else:
@@ -269,6 +278,67 @@ def as_array(x, trail: tuple, what: str):
     if len(shape) < nt or shape[len(shape) - nt :] != trail:
         raise shape_error(what, shape, trail)
     return x
+
+
+_PLAIN = (list, tuple, float, int)
+
+
+def scipy_kind(x) -> str | None:
+    """``"Rotation"`` or ``"RigidTransform"`` for scipy's objects of those classes (and
+    subclasses, such as a ``rigidkit.scipy`` wrapper), else None; scipy is not imported.
+    """
+    for klass in type(x).__mro__:
+        if klass.__module__.startswith("scipy.spatial.transform") and klass.__name__ in (
+            "Rotation",
+            "RigidTransform",
+        ):
+            return klass.__name__
+    return None
+
+
+def foreign_object(x):
+    """The rigidkit object that ``x`` converts to, its class's name, or None.
+
+    ``x.as_rigidkit()`` where it has one (the ``rigidkit.scipy`` classes); a scipy
+    ``Rotation`` or ``RigidTransform`` is returned as is, for its caller to read
+    (``("Rotation", x)``). None for anything else.
+    """
+    make = getattr(x, "as_rigidkit", None)
+    if make is not None and callable(make):
+        obj = make()
+        return type(obj).__name__, obj
+    kind = scipy_kind(x)
+    return None if kind is None else (kind, x)
+
+
+def object_array(x, trail: tuple, what: str):
+    """The array an object stands for where an array of trailing shape ``trail`` is
+    expected: its matrices (shape ``(..., n, n)``) for square ``trail`` of its matrix
+    size, a scipy ``Rotation``'s quaternions ``(w, x, y, z)`` for ``trail == (4,)``.
+
+    A single scipy object gives one element (shape ``trail``). Anything else raises
+    :class:`ShapeError` naming the object and what to pass instead.
+
+    >>> from scipy.spatial.transform import Rotation as SciRot
+    >>> object_array(SciRot.from_quat([0.0, 0.0, 0.0, 1.0]), (4,), "quaternion")
+    array([1., 0., 0., 0.])
+    """
+    made = foreign_object(x)
+    kind, obj = made if made is not None else (type(x).__name__, x)
+    scipy_made = scipy_kind(obj) is not None
+    if len(trail) == 2 and trail[0] == trail[1]:
+        matrix = obj.as_matrix()
+        if tuple(matrix.shape[-2:]) == trail:
+            return matrix
+    elif trail == (4,) and kind == "Rotation":
+        if scipy_made:
+            return obj.as_quat(scalar_first=True)
+        return obj.as_quat()
+    label = f"scipy {kind}" if scipy_made else f"rigidkit.{kind}"
+    raise ShapeError(
+        f"{what}: expected an array of shape {shape_text(trail)}, got a {label} object"
+        f"; pass the array it stands for (its .as_matrix(), .as_quat(), ...)"
+    )
 
 
 def check_finite(x, trail: tuple, what: str) -> None:

@@ -22,6 +22,7 @@ import inspect
 import numpy as np
 
 from .._engine.namespace import _torch_namespace, device_of, namespace_of
+from .._validate import concrete, foreign_object, scipy_kind, to_numpy
 from ..errors import ShapeError
 from . import _pytree
 
@@ -31,6 +32,91 @@ __all__ = ["BatchedArray", "batch_shape"]
 def batch_shape(shape) -> tuple:
     """A batch shape argument (an int or a sequence of ints) as a tuple."""
     return (shape,) if isinstance(shape, int) else tuple(shape)
+
+
+# What to call instead of passing an array where an object is expected, by the
+# object's class and the array's trailing shape (None: any shape).
+_INSTEAD = {
+    "Rotation": {
+        (4,): "rk.Rotation.from_quat(q) for (w, x, y, z), or "
+        "rk.Rotation.from_quat(q, scalar_first=False) for (x, y, z, w) as ROS, scipy "
+        "and Eigen store it",
+        (3, 3): "rk.Rotation.from_matrix(M)",
+        (3,): "rk.Rotation.from_rotvec(v), or rk.Rotation.from_euler(seq, angles)",
+        None: "rk.Rotation.from_quat(q, scalar_first=...), .from_matrix(M), "
+        ".from_rotvec(v) or .from_euler(seq, angles)",
+    },
+    "Transform": {
+        (4, 4): "rk.Transform.from_matrix(M)",
+        (7,): "rk.Transform.from_pq(pq) for (x, y, z, qw, qx, qy, qz), or "
+        "rk.Transform.from_pq(pq, scalar_first=False) for (x, y, z, qx, qy, qz, qw)",
+        None: "rk.Transform.from_matrix(M), rk.Transform.from_pq(pq), or "
+        "rk.Transform(rotation=rk.Rotation..., translation=t)",
+    },
+    "Rotation2D": {None: "rk.Rotation2D.from_angle(theta) or .from_matrix(M)"},
+}
+
+
+def instead(kind: str, x) -> str:
+    """``"; call ... instead"`` for an array ``x`` given where a ``kind`` is expected."""
+    table = _INSTEAD.get(kind)
+    if table is None:
+        return ""
+    shape = tuple(getattr(x, "shape", np.shape(x)) if _is_arraylike(x) else ())
+    if kind == "Rotation":  # a pose given as a Transform's rotation= (its first)
+        if shape[-2:] == (4, 4):
+            return f"; for 4x4 matrices, call {_INSTEAD['Transform'][(4, 4)]}"
+        if shape[-1:] == (7,):
+            return f"; for poses, call {_INSTEAD['Transform'][(7,)]}"
+    trails = sorted((k for k in table if k is not None), key=len, reverse=True)
+    for trail in trails:  # (4, 4) before (4,)
+        if shape[len(shape) - len(trail) :] == trail:
+            return f"; for an array of shape {shape}, call {table[trail]}"
+    return f"; call {table[None]}"
+
+
+def _is_arraylike(x) -> bool:
+    if hasattr(x, "shape"):
+        return True
+    try:
+        np.shape(x)
+    except ValueError:  # ragged
+        return False
+    return isinstance(x, (list, tuple))
+
+
+def expect(x, cls, what: str):
+    """``x`` as an instance of ``cls``: itself, or converted from scipy's ``Rotation``
+    or ``RigidTransform`` (or an object with ``as_rigidkit()``); anything else is a
+    ``TypeError`` saying which constructor to call instead.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import rigidkit as rk
+    >>> try:
+    ...     expect(np.eye(4), rk.Rotation, "rotation")
+    ... except TypeError as err:
+    ...     print(err)  # doctest: +NORMALIZE_WHITESPACE
+    rotation must be a rigidkit.Rotation, got ndarray; for 4x4 matrices, call
+    rk.Transform.from_matrix(M)
+    """
+    if isinstance(x, cls):
+        return x
+    made = foreign_object(x)
+    if made is not None:
+        kind, obj = made
+        if isinstance(obj, cls):
+            return obj
+        converted = cls._from_foreign(kind, obj)
+        if converted is not None:
+            return converted
+    got = type(x).__name__
+    if made is not None:
+        got = f"a {'scipy ' if scipy_kind(x) else ''}{made[0]}"
+    raise TypeError(
+        f"{what} must be a rigidkit.{cls.__name__}, got {got}{instead(cls.__name__, x)}"
+    )
 
 
 def storage_slots(cls) -> tuple:
@@ -45,7 +131,8 @@ def place(data, *, like=None, xp=None, dtype=None, device=None):
     ``like``: an array whose namespace, floating dtype and device are taken (each
     unless given); ``xp``: a namespace (``torch``, ``jax.numpy``, ``numpy``,
     ``array_api_strict``, ...); ``dtype``: a dtype of that namespace or its name
-    (``"float32"``); ``device``: a device of that namespace.
+    (``"float32"``), by default the namespace's default floating dtype
+    (:func:`default_float`); ``device``: a device of that namespace.
     """
     if like is not None:
         if xp is None:
@@ -62,7 +149,16 @@ def place(data, *, like=None, xp=None, dtype=None, device=None):
         dtype = getattr(xp, dtype)
     if xp is np:
         return data if dtype is None else data.astype(dtype)
-    return xp.asarray(data, dtype=dtype or xp.float64, device=device)
+    if dtype is None:
+        dtype = default_float(xp)
+    return xp.asarray(data, dtype=dtype, device=device)
+
+
+def default_float(xp):
+    """The default floating dtype of the namespace ``xp``: ``float32`` for JAX
+    without ``jax_enable_x64`` and for torch unless ``torch.set_default_dtype``
+    says otherwise, ``float64`` for NumPy."""
+    return xp.asarray(0.0).dtype
 
 
 def _placing(make):
@@ -91,7 +187,9 @@ _PLACING_DOC = """
         The result is made in any array namespace: ``like=`` an array (its
         namespace, floating dtype and device), or ``xp=`` a namespace (``torch``,
         ``jax.numpy``, ...), ``dtype=`` (a dtype or its name) and ``device=``; by
-        default NumPy float64.
+        default NumPy float64, and in another namespace its default floating
+        dtype (JAX: float32 unless ``jax_enable_x64`` is on; torch:
+        ``torch.get_default_dtype()``).
 """
 
 
@@ -166,6 +264,12 @@ class BatchedArray:
         return obj
 
     @classmethod
+    def _from_foreign(cls, kind: str, obj):
+        """An instance from scipy's object ``obj`` of class ``kind``, or None where
+        this class has no such conversion (see :func:`expect`)."""
+        return None
+
+    @classmethod
     def _filled(cls, element, shape, dtype=None):
         """A NumPy array of batch ``shape``, each element a copy of ``element``.
 
@@ -233,10 +337,25 @@ class BatchedArray:
             raise ShapeError(f"concatenate needs at least one {cls.__name__}")
         return cls._wrap(namespace_of(*arrays).concat(arrays, axis=0))
 
+    #: The components of one stored element, named in the ``repr`` of a batch.
+    _repr_columns = "values"
+
     def __repr__(self):
         if self.single:
             return self._repr_single()
-        return f"{type(self).__name__}(shape={self.shape}, dtype={self.dtype})"
+        head = f"{type(self).__name__}(shape={self.shape}, dtype={self.dtype}"
+        if not concrete(self._data):  # traced or lazy: no values to show
+            return head + ")"
+        values = np.array2string(
+            np.asarray(to_numpy(self._data)),
+            precision=6,
+            suppress_small=True,
+            separator=", ",
+            threshold=200,  # a few rows first and last, as NumPy summarises
+            edgeitems=3,
+            prefix=" ",
+        )
+        return f"{head}, {self._repr_columns}=\n {values})"
 
     def _repr_single(self) -> str:
         raise NotImplementedError

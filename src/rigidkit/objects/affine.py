@@ -62,6 +62,7 @@ class Affine(BatchedArray, Group, family="space", rank=3):
 
     __slots__ = ("_data",)
     _trail = (3, 4)
+    _repr_columns = "[A | t]"
     _identity = np.eye(3, 4)  # [I | 0]
     _compose_kernel = _k.affine_compose
 

@@ -18,7 +18,7 @@ from .._validate import as_array, finite_array, to_numpy
 from ..functional import conversions as _conv
 from ..functional import se23 as _fse23
 from ..kernels import se23 as _k
-from ._batch import BatchedArray, batch_shape
+from ._batch import BatchedArray, batch_shape, expect
 from ._frozen import frozen
 from .group import LieGroup, owned_method
 from .registry import GroupSpec
@@ -67,6 +67,7 @@ class ExtendedPose(BatchedArray, LieGroup, family="navigation", rank=0):
 
     __slots__ = ("_data",)
     _trail = (10,)
+    _repr_columns = "(qw, qx, qy, qz, vx, vy, vz, px, py, pz)"
     _identity = (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)  # (q, v, p)
     _compose_kernel = _k.extpose_compose
     _inverse_kernel = _k.extpose_inv
@@ -83,9 +84,7 @@ class ExtendedPose(BatchedArray, LieGroup, family="navigation", rank=0):
 
     def __init__(self, rotation=None, velocity=None, position=None):
         if rotation is not None and not isinstance(rotation, Rotation):
-            raise TypeError(
-                f"rotation must be a rigidkit.Rotation, got {type(rotation).__name__}"
-            )
+            rotation = expect(rotation, Rotation, "rotation")
         v = None if velocity is None else finite_array(velocity, (3,), "velocity")
         p = None if position is None else finite_array(position, (3,), "position")
         q = None if rotation is None else rotation.as_quat()

@@ -70,6 +70,7 @@ class Projective(BatchedArray, Group, family="space", rank=4):
 
     __slots__ = ("_data",)
     _trail = (4, 4)
+    _repr_columns = "H"
     _identity = np.eye(4)
     _compose_kernel = _k.projective_compose
 

@@ -59,6 +59,7 @@ class Quaternion(BatchedArray):
     __slots__ = ("_q", "_data")  # one array under two names (see _batch)
     _storage = "_q"
     _trail = (4,)
+    _repr_columns = "(w, x, y, z)"
     # NumPy's binary operators defer to ours (ndarray * Quaternion -> __rmul__).
     __array_ufunc__ = None
 

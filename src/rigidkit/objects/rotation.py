@@ -26,7 +26,7 @@ from ..functional import so3 as _so3
 from ..functional import swing_twist as _st
 from ..functional import symmetry as _sym
 from ..kernels.kinematics import integration as _ki
-from ._batch import BatchedArray, batch_shape
+from ._batch import BatchedArray, batch_shape, expect
 from ._frozen import frozen
 from .group import LieGroup
 from .registry import GroupSpec
@@ -56,6 +56,7 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
     __slots__ = ("_quat", "_data")  # one array under two names (see _batch)
     _storage = "_quat"
     _trail = (4,)
+    _repr_columns = "(w, x, y, z)"
     _identity = (1.0, 0.0, 0.0, 0.0)
     _compose_kernel = _conv.quat_compose
     _inverse_kernel = _quaternion.conjugate
@@ -68,9 +69,17 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
     )
 
     def __init__(self, quat, *, _normalized=False):
-        if not _normalized:
+        if type(quat) is not np.ndarray and hasattr(quat, "as_matrix"):
+            quat = expect(quat, Rotation, "Rotation(quat)")._quat  # scipy's: converted
+        elif not _normalized:
             quat = _conv.quat_normalize(quat)
         self._quat = self._data = quat
+
+    @classmethod
+    def _from_foreign(cls, kind, obj):
+        if kind == "Rotation":  # scipy's
+            return cls._wrap(_conv.quat_normalize(obj.as_quat(scalar_first=True)))
+        return None
 
     # -- construction -------------------------------------------------------
     @classmethod
@@ -83,6 +92,8 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
         >>> Rotation.from_quat([0.0, 0.0, 0.0, 2.0], scalar_first=False).as_quat()
         array([1., 0., 0., 0.])
         """
+        if type(quat) is not np.ndarray and hasattr(quat, "as_matrix"):
+            return expect(quat, cls, "quat")  # an object: no order to choose
         q = as_array(quat, (4,), "quaternion")
         if not scalar_first:
             q = _conv.quat_wxyz_from_xyzw(q)

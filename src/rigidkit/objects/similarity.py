@@ -22,7 +22,7 @@ from ..errors import NotASimilarityError
 from ..functional import conversions as _conv
 from ..functional import sim3 as _fsim3
 from ..kernels import sim3 as _k
-from ._batch import BatchedArray, batch_shape
+from ._batch import BatchedArray, batch_shape, expect
 from ._frozen import frozen
 from .affine import Affine
 from .group import LieGroup
@@ -66,6 +66,7 @@ class Similarity(BatchedArray, LieGroup, family="space", rank=2):
 
     __slots__ = ("_data",)
     _trail = (8,)
+    _repr_columns = "(qw, qx, qy, qz, tx, ty, tz, s)"
     _identity = (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)  # (q, t, s)
     _compose_kernel = _k.sim3_compose
     dof, matrix_size, point_dim = 7, 4, 3
@@ -80,9 +81,7 @@ class Similarity(BatchedArray, LieGroup, family="space", rank=2):
 
     def __init__(self, scale=None, rotation=None, translation=None):
         if rotation is not None and not isinstance(rotation, Rotation):
-            raise TypeError(
-                f"rotation must be a rigidkit.Rotation, got {type(rotation).__name__}"
-            )
+            rotation = expect(rotation, Rotation, "rotation")
         q = None if rotation is None else rotation.as_quat()
         t = None
         if translation is not None:

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._engine.namespace import device_of, namespace_of
-from .._validate import as_array, finite_array, to_numpy
+from .._validate import as_array, finite_array, scipy_kind, to_numpy
 from ..functional import averaging as _avg
 from ..functional import conversions as _conv
 from ..functional import interpolation as _interp
@@ -21,7 +21,7 @@ from ..functional import se3 as _se3
 from ..kernels import pose_formats as _kpf
 from ..kernels import se3 as _k
 from ..kernels.kinematics import integration as _ki
-from ._batch import BatchedArray, batch_shape
+from ._batch import BatchedArray, batch_shape, expect
 from ._frozen import frozen
 from .group import LieGroup, owned_method
 from .registry import GroupSpec
@@ -66,6 +66,7 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
     __slots__ = ("_pose", "_data")  # one array under two names (see _batch)
     _storage = "_pose"
     _trail = (7,)
+    _repr_columns = "(qw, qx, qy, qz, tx, ty, tz)"
     _identity = (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)  # (w, x, y, z, tx, ty, tz)
     _compose_kernel = _k.pose_compose
     _inverse_kernel = _k.pose_inv
@@ -79,9 +80,12 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
 
     def __init__(self, rotation=None, translation=None):
         if rotation is not None and not isinstance(rotation, Rotation):
-            raise TypeError(
-                f"rotation must be a rigidkit.Rotation, got {type(rotation).__name__}"
-            )
+            if translation is None and scipy_kind(rotation) == "RigidTransform":
+                self._pose = self._data = Transform._from_foreign(
+                    "RigidTransform", rotation
+                )._pose
+                return
+            rotation = expect(rotation, Rotation, "rotation")
         if translation is not None:
             translation = finite_array(translation, (3,), "translation")
         if rotation is None and translation is None:
@@ -94,6 +98,13 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
         if translation is None:
             translation = _constant_like(quat, [0.0, 0.0, 0.0])
         self._pose = self._data = _k.pose_from_quat_translation(quat, translation)
+
+    @classmethod
+    def _from_foreign(cls, kind, obj):
+        if kind == "RigidTransform":  # scipy's
+            rotation = Rotation._from_foreign("Rotation", obj.rotation)
+            return cls(rotation=rotation, translation=obj.translation)
+        return None
 
     # -- construction ------------------------------------------------------------------
     @classmethod
@@ -311,10 +322,7 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
         >>> float(A.distance_to(Transform()))
         5.0
         """
-        if not isinstance(other, Transform):
-            raise TypeError(
-                f"other must be a rigidkit.Transform, got {type(other).__name__}"
-            )
+        other = expect(other, Transform, "other")
         return _k.pose_distance(
             _se3._weight(rotation_weight, "rotation_weight"),
             _se3._weight(translation_weight, "translation_weight"),

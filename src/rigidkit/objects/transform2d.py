@@ -15,7 +15,7 @@ from .._validate import as_array, finite_array, to_numpy
 from ..functional import se2 as _se2
 from ..kernels import se2 as _k
 from ..kernels.kinematics import planar as _kp
-from ._batch import BatchedArray, batch_shape
+from ._batch import BatchedArray, batch_shape, expect
 from ._frozen import frozen
 from .group import LieGroup
 from .registry import GroupSpec
@@ -59,6 +59,7 @@ class Transform2D(BatchedArray, LieGroup, family="plane", rank=1):
 
     __slots__ = ("_data",)
     _trail = (4,)
+    _repr_columns = "(cos, sin, tx, ty)"
     _identity = (1.0, 0.0, 0.0, 0.0)  # (cos 0, sin 0, tx, ty)
     _compose_kernel = _k.pose_multiply
     _inverse_kernel = _k.pose_inverse
@@ -72,7 +73,7 @@ class Transform2D(BatchedArray, LieGroup, family="plane", rank=1):
 
     def __init__(self, rotation=None, translation=None):
         if rotation is not None and not isinstance(rotation, Rotation2D):
-            raise TypeError(f"rotation must be a Rotation2D, got {type(rotation).__name__}")
+            rotation = expect(rotation, Rotation2D, "rotation")
         if translation is None:
             cs = Rotation2D.identity()._data if rotation is None else rotation._data
             self._data = namespace_of(cs).concat([cs, cs * 0.0], axis=-1)
