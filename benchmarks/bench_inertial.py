@@ -74,6 +74,10 @@ def _warm(rk):
             method=method,
         )
     _scan.wait(_k.sgal_chain, np.float64)
+    from rigidkit.applications.inertial import _fold
+
+    for method in ("exact", "forster", "midpoint"):
+        _fold.wait(method)  # the compiled one-pass loops (minutes on a cold cache)
     numba_backend.drain(timeout=600)
 
 
@@ -121,6 +125,16 @@ def preintegration_rows(rk, repeat, notes):
         m: (lambda m=m: rk.inertial.preintegrate(w, f, h, noise=noise, method=m))
         for m in ("exact", "forster", "midpoint")
     }
+    # The array path (steps, Jacobians, scan and per-step sensitivities as whole
+    # arrays, by chunks of windows): what preintegrate ran before the compiled fold,
+    # and still runs on torch and JAX and while the fold compiles.
+    from rigidkit.applications.inertial import preintegration as P
+
+    zero = np.zeros(3)
+    for m in ("exact", "forster", "midpoint"):
+        fns[f"{m} (array path)"] = lambda m=m: P._chunked(
+            w, f, np.asarray(h), zero, zero, noise, m, (windows,)
+        )
     peers = {}
     try:
         import gtsam
@@ -215,23 +229,32 @@ def main(argv=None):
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--json", help="write the rows to this file")
     ap.add_argument("--quick", action="store_true", help="sizes / 100: a smoke run")
+    ap.add_argument(
+        "--only",
+        nargs="+",
+        choices=("strapdown", "preintegration", "groups"),
+        help="run only these sections",
+    )
     args = ap.parse_args(argv)
+    want = set(args.only or ("strapdown", "preintegration", "groups"))
     SCALE["scale"] = 100 if args.quick else 1
     import rigidkit as rk
 
     print(f"cores: {C.cpu_count()}, load: {C.load_average()}")
     _warm(rk)
     notes: list = []
-    out = {
-        "strapdown": strapdown_rows(rk, args.repeat),
-        "preintegration": preintegration_rows(rk, args.repeat, notes),
-        "groups": group_rows(rk, args.repeat),
-    }
-    print(C.table(["strapdown", "logs", "ns/step"], out["strapdown"]))
-    print()
-    print(C.table(["preintegration", "samples", "ns/sample", "vs"], out["preintegration"]))
-    print()
-    print(C.table(["N = 1e6", "ExtendedPose ns", "Transform ns", "ratio"], out["groups"]))
+    out = {}
+    if "strapdown" in want:
+        out["strapdown"] = strapdown_rows(rk, args.repeat)
+        print(C.table(["strapdown", "logs", "ns/step"], out["strapdown"]), end="\n\n")
+    if "preintegration" in want:
+        out["preintegration"] = preintegration_rows(rk, args.repeat, notes)
+        head = ["preintegration", "samples", "ns/sample", "vs"]
+        print(C.table(head, out["preintegration"]), end="\n\n")
+    if "groups" in want:
+        out["groups"] = group_rows(rk, args.repeat)
+        head = ["N = 1e6", "ExtendedPose ns", "Transform ns", "ratio"]
+        print(C.table(head, out["groups"]))
     for note in notes:
         print(note)
     if args.json:

@@ -371,3 +371,130 @@ def test_the_rate_of_cos_defect4_against_mpmath():
 
     want = np.array([ref(v) for v in x])
     np.testing.assert_allclose(got, want, rtol=8 * np.finfo(float).eps, atol=0)
+
+
+# -- the compiled fold (NumPy's path for large calls) ----------------------------------
+@pytest.fixture
+def folds(monkeypatch):
+    """Every call takes the compiled fold (built, or loaded from the disk cache,
+    first): FOLD_MIN 0, and each method's fold waited for."""
+    from rigidkit.applications.inertial import _fold
+
+    if not rk._engine.numba_available():
+        pytest.skip("numba is not installed")
+    for method in ("exact", "forster", "midpoint"):
+        _fold.wait(method)
+    monkeypatch.setattr(_fold, "FOLD_MIN", 0)
+    return _fold
+
+
+def _array_path(w, f, h, bg, ba, noise, method):
+    """The array path (steps, Jacobians, scan and sensitivities as whole arrays)."""
+    from rigidkit.applications.inertial import preintegration as P
+
+    return P._preintegrate(w, f, h, bg, ba, noise, method, np)
+
+
+@pytest.mark.parametrize("method", ["exact", "forster", "midpoint"])
+def test_the_fold_is_the_array_path(folds, method, rng):
+    """One compiled pass per window (the running product with the sums ``G``, ``P``
+    and the end map ``L``) gives the array path's increments, bias Jacobians and
+    covariance to rounding: windows of a (2, 3) batch, per-window biases, per-step
+    durations with zero-duration padding, and no noise (no covariance)."""
+    n = 40
+    w = 0.8 * rng.standard_normal((2, 3, n, 3))
+    f = 2.0 * rng.standard_normal((2, 3, n, 3))
+    h = rng.uniform(0.002, 0.02, (2, 3, n))
+    h[1, 2, 30:] = 0.0  # a shorter window, padded
+    bg = 0.05 * rng.standard_normal((2, 3, 3))
+    ba = 0.1 * rng.standard_normal(3)
+    noise = rk.inertial.ImuNoise(2e-3, 3e-2)
+    pim = rk.inertial.preintegrate(
+        w, f, h, gyro_bias=bg, accel_bias=ba, noise=noise, method=method
+    )
+    ref = _array_path(w, f, h, bg, ba, noise, method)
+    assert pim.shape == (2, 3)
+    np.testing.assert_allclose(pim._delta, ref._delta, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(
+        pim._jacobian, ref._jacobian, rtol=0, atol=1e-14 * np.abs(ref._jacobian).max()
+    )
+    scale = np.abs(ref.covariance).max()
+    np.testing.assert_allclose(pim.covariance, ref.covariance, rtol=0, atol=1e-14 * scale)
+    np.testing.assert_array_equal(pim.gyro_bias, np.broadcast_to(bg, (2, 3, 3)))
+    # the padded window ends where its last real step does
+    short = _array_path(
+        w[1, 2, :30], f[1, 2, :30], h[1, 2, :30], bg[1, 2], ba, noise, method
+    )
+    if method != "midpoint":  # midpoint's last real step reads the next sample
+        np.testing.assert_allclose(pim[1, 2]._delta, short._delta, rtol=0, atol=1e-14)
+    quiet = rk.inertial.preintegrate(w[0, 0], f[0, 0], 0.01, method=method)
+    assert quiet.covariance is None
+    ref = _array_path(
+        w[0, 0], f[0, 0], np.asarray(0.01), np.zeros(3), np.zeros(3), None, method
+    )
+    np.testing.assert_allclose(quiet._jacobian, ref._jacobian, rtol=0, atol=1e-14)
+
+
+def test_the_fold_keeps_float32_and_its_jacobians_are_finite_differences(folds, rng):
+    w, f = log(rng, 25)
+    dt = rng.uniform(0.01, 0.03, 25)
+    pim = rk.inertial.preintegrate(
+        w.astype(np.float32), f.astype(np.float32), dt.astype(np.float32), method="exact"
+    )
+    assert pim._delta.dtype == np.float32 and pim._jacobian.dtype == np.float32
+    ref = _array_path(w, f, dt, np.zeros(3), np.zeros(3), None, "exact")
+    np.testing.assert_allclose(pim._delta, ref._delta, rtol=0, atol=2e-5)
+    # The fold's bias Jacobians against central differences of the fold itself.
+    bg = 0.05 * rng.standard_normal(3)
+    pim = rk.inertial.preintegrate(w, f, dt, gyro_bias=bg, method="exact")
+    R0, v0, p0 = pim.delta_R.as_matrix(), pim.delta_v, pim.delta_p
+    e = 1e-6
+    fd = np.zeros((9, 3))
+    for i in range(3):
+        d = np.zeros(3)
+        d[i] = e
+        cols = [
+            errors(rk.inertial.preintegrate(w, f, dt, gyro_bias=bg + s * d), R0, v0, p0)
+            for s in (1, -1)
+        ]
+        fd[:, i] = (cols[0] - cols[1]) / (2 * e)
+    np.testing.assert_allclose(pim.jacobian_gyro_bias, fd, rtol=0, atol=2e-8)
+
+
+def test_against_pypose_converging_at_first_order():
+    """pypose's ``IMUPreintegrator`` (Forster's recursion, gravity removed per sample in
+    the body frame) and our ``"forster"`` increments with ``predict`` from the
+    identity: the same rotation (a product of ``Exp(w h)``), and velocity and position
+    gaps that halve with the step (pypose removes gravity with the rotation at a
+    step's end, Forster's recursion with the increments at its start: first order).
+    Skipped without pypose."""
+    pp = pytest.importorskip("pypose")
+    torch = pytest.importorskip("torch")
+    g = 9.81007
+
+    def gap(n):
+        t = np.arange(n) / n
+        w = np.stack([0.5 * np.sin(t), 0.3 * np.cos(2 * t), 0.2 + 0 * t], -1)
+        f = np.stack([np.cos(t), 1 + np.sin(3 * t), g + 0 * t], -1)
+        integrator = pp.module.IMUPreintegrator(
+            gravity=g, prop_cov=False, reset=True
+        ).double()
+        with torch.no_grad():
+            out = integrator(
+                torch.full((1, n, 1), 1 / n, dtype=torch.float64),
+                torch.tensor(w[None]),
+                torch.tensor(f[None]),
+            )
+        X = rk.inertial.preintegrate(w, f, 1 / n, method="forster").predict(
+            rk.ExtendedPose(), gravity=(0.0, 0.0, -g)
+        )
+        quat = out["rot"][0, -1].tensor().numpy()  # pypose: (x, y, z, w)
+        R = SciRot.from_quat(quat).as_matrix()
+        np.testing.assert_allclose(R, X.rotation.as_matrix(), rtol=0, atol=1e-12)
+        return (
+            np.abs(out["vel"][0, -1].numpy() - X.velocity).max(),
+            np.abs(out["pos"][0, -1].numpy() - X.position).max(),
+        )
+
+    (v1, p1), (v2, p2) = gap(100), gap(200)
+    assert 1.8 < v1 / v2 < 2.2 and 1.8 < p1 / p2 < 2.2, (v1, v2, p1, p2)

@@ -299,10 +299,10 @@ def fold_source(step, carried: int, summed: int, inputs) -> str:
     """
     fns = [*step.dependencies(), step]
     parts = [NUMBA_PRELUDE]
-    for f in fns:
+    for f in fns:  # numba's inliner cannot take a call with *args: such a one is called
+        inline = "" if _has_star_call(f.fn) else "inline='always', "
         parts.append(
-            "\n\n@numba.njit(inline='always', error_model='numpy')\n"
-            + function_source(f.fn)
+            f"\n\n@numba.njit({inline}error_model='numpy')\n" + function_source(f.fn)
         )
     names = [f"in{j}" for j in range(len(inputs))]
     args = [f"{name}[b, k, {c}]" for name, w in zip(names, inputs) for c in range(w)]

@@ -34,6 +34,7 @@ from ...kernels.kinematics import inertial_jacobians as _kj
 from ...objects.extended_pose import ExtendedPose
 from ...objects.rotation import Rotation
 from ..kinematics.integration import _steps
+from . import _fold
 from .strapdown import GRAVITY, running_steps, samples, vector_like
 
 __all__ = ["ImuNoise", "Preintegrated", "preintegrate", "to_gtsam", "from_gtsam"]
@@ -330,6 +331,14 @@ def preintegrate(
     )
     n = w.shape[-2]
     windows = int(np.prod(batch, dtype=np.int64))
+    if all(type(x) is np.ndarray for x in (w, f, h, bg, ba)):
+        fold = _fold.ready(method, windows * n)
+        if fold is not None:
+            parts = _fold.folded(fold, method, w, f, h, bg, ba, noise, batch, w.dtype)
+            delta, J, cov = parts
+            bg = np.broadcast_to(bg, batch + (3,))
+            ba = np.broadcast_to(ba, batch + (3,))
+            return Preintegrated(delta, J, cov, bg, ba)
     if is_numpy(xp) and windows > 1 and windows * n > _CHUNK:
         return _chunked(w, f, h, bg, ba, noise, method, batch)
     return _preintegrate(w, f, h, bg, ba, noise, method, xp)

@@ -132,6 +132,16 @@ def scale9(k, u):
 
 
 @helper
+def mat33_product(a, b):
+    """``A B`` of 3x3 matrices given as 9-tuples (row-major), without ``*`` calls
+    (which a compiled fold cannot inline)."""
+    return mat33_mul(
+        a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7], a[8],
+        b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7], b[8],
+    )  # fmt: skip
+
+
+@helper
 def add_diag9(u, k):
     """``u + k I`` of a 9-tuple (a 3x3 matrix)."""
     return (u[0] + k, u[1], u[2], u[3], u[4] + k, u[5], u[6], u[7], u[8] + k)
@@ -196,7 +206,7 @@ def imu_step_jacobian_midpoint(ax, ay, az, fx, fy, fz, bx, by, bz, gx, gy, gz, h
     qw, qx, qy, qz, _, _, _ = vins_mean(ax, ay, az, fx, fy, fz, bx, by, bz, gx, gy, gz, h)
     e = eye_hat_hat2(qx, qy, qz, 2.0 * qw, 2.0)  # R of a unit quaternion
     hf = (0.0, -gz, gy, gz, 0.0, -gx, -gy, gx, 0.0)
-    dm_w = mat33_mul(*mat33_mul(*e, *hf), *jr)
+    dm_w = mat33_product(mat33_product(e, hf), jr)
     dm_w = scale9(-0.5 * h, dm_w)
     dm_f = scale9(0.5, add_diag9(e, 1.0))
     k = 0.5 * h * h
