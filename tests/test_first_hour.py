@@ -37,6 +37,18 @@ import rigidkit as rk
             lambda: rk.Transform().distance_to(np.eye(4)),
             "rk.Transform.from_matrix(M)",
         ),
+        (
+            lambda: rk.Trajectory(np.arange(3.0), np.tile(np.eye(4), (3, 1, 1))),
+            "rk.Transform.from_matrix(M)",
+        ),
+        (
+            lambda: rk.Trajectory(np.arange(3.0), np.zeros((3, 7))),
+            "rk.Transform.from_pq(pq, scalar_first=False) for (x, y, z, qx, qy, qz, qw)",
+        ),
+        (
+            lambda: rk.UncertainTransform(np.eye(4), np.eye(6)),
+            "rk.Transform.from_matrix(M)",
+        ),
     ],
 )
 def test_an_array_where_an_object_is_expected_names_the_constructor(make, hint):

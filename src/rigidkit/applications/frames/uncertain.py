@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import ShapeError
+from ...objects._batch import expect
 from ...objects.transform import Transform
 from .. import jacobians as _jac
 
@@ -72,7 +73,7 @@ class UncertainTransform:
 
     def __init__(self, mean, cov, side="right"):
         if not isinstance(mean, Transform):
-            raise TypeError(f"mean must be a rigidkit.Transform, got {type(mean).__name__}")
+            mean = expect(mean, Transform, "mean")  # says which constructor to call
         if side not in _SIDES:
             raise ValueError(f"side must be 'right' or 'left', got {side!r}")
         if isinstance(cov, np.ndarray) or not hasattr(cov, "shape"):

@@ -6,6 +6,7 @@ import numpy as np
 
 from ..._engine.namespace import is_torch, namespace_of
 from ...errors import OutOfRangeError, ShapeError, TimestampError
+from ...objects._batch import expect
 from ...objects.similarity import Similarity
 from ...objects.transform import Transform
 from ..interpolation import Slerp
@@ -98,9 +99,7 @@ class Trajectory:
 
     def __init__(self, stamps, poses):
         if not isinstance(poses, Transform):
-            raise TypeError(
-                f"poses must be a rigidkit.Transform, got {type(poses).__name__}"
-            )
+            poses = expect(poses, Transform, "poses")  # says which constructor to call
         if poses.single:
             raise ShapeError("a Trajectory needs poses with a time axis, shape (..., N)")
         n = poses.shape[-1]
