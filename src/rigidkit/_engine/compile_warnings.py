@@ -20,7 +20,11 @@ of its own, the filter calls change nothing, and a warning issued there
 goes to the innermost such recording, or else to :func:`compile_warnings`, never
 to the process's filters and ``showwarning``. numba's import (run on that
 thread) and its loads from the disk cache (:func:`.numba_backend.jit_signatures`)
-touch none of that state at all.
+touch none of that state at all (traced on numba 0.68). One case is left: a
+module of another package that numba's first compile in a process imports, on
+that thread, and that enters ``catch_warnings`` in its body: ``scipy._lib._util``
+does once, through numba's BLAS probe, when ``scipy.linalg`` was not imported
+before (a cold disk cache only).
 
 >>> import warnings
 >>> SHIM.catch_warnings is not warnings.catch_warnings   # a function of the thread
