@@ -13,7 +13,8 @@ import math
 
 import numpy as np
 
-from ...errors import RigidkitError
+from ...errors import NotARotationError, RigidkitError
+from ...kernels import pose_formats as _kpf
 from ...objects.rotation import Rotation as _RkRotation
 from ..alignment import align_vectors as _align_vectors
 from ..interpolation import Slerp as _RkSlerp
@@ -22,6 +23,8 @@ from ._arrays import as_float, scalar
 __all__ = ["Rotation", "Slerp"]
 
 _wrap_rk = _RkRotation._wrap
+_quat_from_xyzw = _kpf.quat_from_xyzw
+_xyzw_from_quat = _kpf.xyzw_from_quat
 _from_quat_rk = _RkRotation.from_quat
 
 
@@ -99,6 +102,16 @@ class Rotation:
         q = as_float(quat)
         if q.shape[-1:] != (4,):
             _check_trail(q, (4,), "quat")
+        if not scalar_first and type(q) is np.ndarray:
+            # One pass (reorder and normalise); a zero or non-finite norm sends the
+            # call to rigidkit's checked path, which raises naming the batch index.
+            wxyz, n = _quat_from_xyzw(q)
+            if type(n) is np.ndarray and n.ndim:
+                ok = n.size == 0 or (0.0 < n.min() and n.max() < math.inf)
+            else:
+                ok = 0.0 < n < math.inf
+            if ok:
+                return _new(_wrap_rk(wxyz))
         return _new(_from_quat_rk(q, scalar_first=scalar_first))
 
     @staticmethod
@@ -112,8 +125,11 @@ class Rotation:
             )
         if assume_valid:
             return _new(_RkRotation.from_matrix(m, atol=math.inf))
-        det = _det3(m)
-        if bool((det <= 0).any()):
+        try:  # the common case, a rotation to rounding: validated and projected
+            return _new(_RkRotation.from_matrix(m))
+        except NotARotationError:
+            pass
+        if bool((_det3(m) <= 0).any()):
             raise ValueError(
                 "Non-positive determinant (left-handed or null coordinate frame) in "
                 "rotation matrix."
@@ -532,12 +548,12 @@ def _wxyz(q):
     return _cat(q[..., 3:], q[..., :3])
 
 
+_TO_XYZW = np.array([1, 2, 3, 0])
+
+
 def _xyzw(q):
     if type(q) is np.ndarray:
-        out = np.empty_like(q)
-        out[..., :3] = q[..., 1:]
-        out[..., 3] = q[..., 0]
-        return out
+        return _xyzw_from_quat(q) if q.ndim > 1 else q.take(_TO_XYZW)
     return _cat(q[..., 1:], q[..., :1])
 
 
