@@ -247,3 +247,31 @@ def test_torch_inputs_stay_torch(torch, pair):
         np.testing.assert_allclose(
             cov.numpy(), A.transform_point(np.array([0.5, -1.0, 2.0]))[1], atol=1e-12
         )
+
+
+def test_jax_inputs_stay_jax_and_trace(jax, jnp, pair):
+    """First-order propagation on JAX arrays: JAX out, NumPy's numbers, and the same
+    under ``jax.jit`` (the composed covariance as a function of the two means)."""
+    X, Y, rng = pair
+    C1, C2 = random_cov(rng, 0.1), random_cov(rng, 0.2)
+    pX, pY = jnp.asarray(np.asarray(X.as_pq())), jnp.asarray(np.asarray(Y.as_pq()))
+    for side in ("right", "left"):
+        A, B = rk.UncertainTransform(X, C1, side), rk.UncertainTransform(Y, C2, side)
+        jA = rk.UncertainTransform(rk.Transform.from_pq(pX), jnp.asarray(C1), side)
+        jB = rk.UncertainTransform(rk.Transform.from_pq(pY), jnp.asarray(C2), side)
+        for ours, ref in (
+            (jA.compose(jB), A.compose(B)),
+            (jA.compose(jB, order=4), A.compose(B, order=4)),
+            (jA.inv(), A.inv()),
+            (jA.between(jB), A.between(B)),
+        ):
+            assert isinstance(ours.cov, jax.Array)
+            np.testing.assert_allclose(np.asarray(ours.cov), ref.cov, atol=1e-12)
+
+        def composed(a, b, side=side):
+            U = rk.UncertainTransform(rk.Transform.from_pq(a), jnp.asarray(C1), side)
+            V = rk.UncertainTransform(rk.Transform.from_pq(b), jnp.asarray(C2), side)
+            return U.compose(V).cov
+
+        got = jax.jit(composed)(pX, pY)
+        np.testing.assert_allclose(np.asarray(got), A.compose(B).cov, atol=1e-12)

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..._engine.namespace import device_of, is_numpy, namespace_of
 from ...errors import ShapeError
 from ...objects._batch import expect
 from ...objects.transform import Transform
@@ -251,16 +252,28 @@ def _ad_op(S):
     """Barfoot's ``<<S>>`` of a 6x6 matrix,
     ``[[<<S_ww>>, <<S_vw + S_vw^T>>], [0, <<S_ww>>]]``, with ``<<M>> = -tr(M) I + M``
     for 3x3 blocks (Barfoot & Furgale 2014, eq. 56)."""
-    out = np.zeros(S.shape)
-    out[..., :3, :3] = _op3(S[..., 3:, 3:])
-    out[..., :3, 3:] = _op3(S[..., :3, 3:] + _mT(S[..., :3, 3:]))
-    out[..., 3:, 3:] = out[..., :3, :3]
-    return out
+    ww = _op3(S[..., 3:, 3:])
+    vw = _op3(S[..., :3, 3:] + _mT(S[..., :3, 3:]))
+    return _blocks([[ww, vw], [0.0 * ww, ww]])
 
 
 def _op3(M):
-    tr = np.trace(M, axis1=-2, axis2=-1)[..., None, None]
-    return -tr * np.eye(3) + M
+    tr = (M[..., 0, 0] + M[..., 1, 1] + M[..., 2, 2])[..., None, None]
+    return M - tr * _eye3(M)
+
+
+def _eye3(like):
+    """The 3x3 identity in the namespace, dtype and device of ``like``."""
+    xp = namespace_of(like)
+    if is_numpy(xp):
+        return np.eye(3, dtype=like.dtype)
+    return xp.asarray(np.eye(3), dtype=like.dtype, device=device_of(like))
+
+
+def _blocks(rows):
+    """A block matrix from rows of blocks (NumPy, torch and JAX alike)."""
+    xp = namespace_of(rows[0][0])
+    return xp.concat([xp.concat(r, axis=-1) for r in rows], axis=-2)
 
 
 def _pair(M, N):
@@ -274,33 +287,24 @@ def _compose4(X, Y):
     Worked on the left side, ``T_i = exp(xi_i) mean_i``: with ``S_2' = Ad(mean_1)
     S_2 Ad(mean_1)^T``, ``S = S_1 + S_2' + (A_1 S_2' + S_2' A_1^T + A_2' S_1 +
     S_1 A_2'^T) / 12 + B / 4``, ``A = <<S>>`` and ``B`` of the 3x3 blocks
-    (``rho`` = v, ``phi`` = omega).
+    (``rho`` = v, ``phi`` = omega). Written with matrix products and block
+    concatenation only, so it runs (and differentiates) on torch and JAX too.
     """
     side = X.side
     Xl, Yl = X.to_side("left"), Y.to_side("left")
     M1 = Xl.mean
-    S1 = np.asarray(Xl.cov)
-    Ad1 = np.asarray(M1.adjoint())
-    S2 = Ad1 @ np.asarray(Yl.cov) @ _mT(Ad1)
-    S1, S2 = np.broadcast_arrays(S1, S2)
+    S1 = Xl.cov
+    S2 = _sandwich(M1.adjoint(), Yl.cov)
+    xp = namespace_of(S1, S2)
+    batch = tuple(np.broadcast_shapes(tuple(S1.shape[:-2]), tuple(S2.shape[:-2])))
+    S1 = xp.broadcast_to(S1, batch + (6, 6))
+    S2 = xp.broadcast_to(S2, batch + (6, 6))
     A1, A2 = _ad_op(S1), _ad_op(S2)
-    rr, rp, pp = (slice(0, 3), slice(0, 3)), (slice(0, 3), slice(3, 6)), (slice(3, 6),) * 2
-
-    def blk(S, ij):
-        return S[(..., *ij)]
-
-    B = np.zeros(S1.shape)
-    B[..., :3, :3] = (
-        _pair(blk(S1, pp), blk(S2, rr))
-        + _pair(_mT(blk(S1, rp)), blk(S2, rp))
-        + _pair(blk(S1, rp), _mT(blk(S2, rp)))
-        + _pair(blk(S1, rr), blk(S2, pp))
-    )
-    B[..., :3, 3:] = _pair(blk(S1, pp), _mT(blk(S2, rp))) + _pair(
-        _mT(blk(S1, rp)), blk(S2, pp)
-    )
-    B[..., 3:, :3] = _mT(B[..., :3, 3:])
-    B[..., 3:, 3:] = _pair(blk(S1, pp), blk(S2, pp))
+    rr1, rp1, pp1 = S1[..., :3, :3], S1[..., :3, 3:], S1[..., 3:, 3:]
+    rr2, rp2, pp2 = S2[..., :3, :3], S2[..., :3, 3:], S2[..., 3:, 3:]
+    b_rr = _pair(pp1, rr2) + _pair(_mT(rp1), rp2) + _pair(rp1, _mT(rp2)) + _pair(rr1, pp2)
+    b_rp = _pair(pp1, _mT(rp2)) + _pair(_mT(rp1), pp2)
+    B = _blocks([[b_rr, b_rp], [_mT(b_rp), _pair(pp1, pp2)]])
     S = S1 + S2 + (A1 @ S2 + S2 @ _mT(A1) + A2 @ S1 + S1 @ _mT(A2)) / 12.0 + B / 4.0
     return UncertainTransform(M1 @ Yl.mean, S, "left").to_side(side)
 
