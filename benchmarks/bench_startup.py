@@ -24,7 +24,7 @@ import subprocess
 import sys
 
 #: Window edges in seconds since import began; the last window is the steady state.
-EDGES = (0.0, 0.1, 0.2, 0.3, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0)
+EDGES = (0.0, 0.1, 0.2, 0.3, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0)
 
 #: One-element ops: setup code (``rk``, ``np`` in scope) and the call timed.
 OPS = {

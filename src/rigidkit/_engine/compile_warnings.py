@@ -19,7 +19,7 @@ of its own, the filter calls change nothing, and a warning issued there
 (``warn``, ``warn_explicit``: numba's ``NumbaWarning``s about a generated loop)
 goes to the innermost such recording, or else to :func:`compile_warnings`, never
 to the process's filters and ``showwarning``. numba's import (run on that
-thread) and its loads from the disk cache (:func:`.numba_backend.jit_signatures`)
+thread) and its loads from the disk cache (:func:`.numba_loads.jit_signatures`)
 touch none of that state at all (traced on numba 0.68). One case is left: a
 module of another package that numba's first compile in a process imports, on
 that thread, and that enters ``catch_warnings`` in its body: ``scipy._lib._util``

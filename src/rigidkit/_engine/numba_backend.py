@@ -32,6 +32,7 @@ import sys
 import threading
 
 from .loop_source import SINGLE, loop_options, module_source
+from .numba_loads import jit_signatures
 
 __all__ = [
     "PARALLEL_MIN",
@@ -178,58 +179,6 @@ def compile_loop(kernel, bcast, dtype, ints=(), nogil=False):
     module, cache = _module(kernel, bcast, nogil)
     sig = signature(kernel, bcast, dtype, ints)
     return jit_signatures(module.loop, [sig], cache, **loop_options(nogil))
-
-
-def jit_signatures(fn, sigs, cache, **options):
-    """``numba.njit(sigs, cache=cache, **options)(fn)``, its loads from the disk
-    cache without numba's first-use set-up.
-
-    numba refreshes its target context before it reads a function from its disk
-    cache (``load_overload``): the first time in a process that installs every
-    typing and lowering registry and imports ``numba.np.arraymath``, whose BLAS
-    probe imports ``scipy.linalg`` (1.0-1.8 s of a fresh process, against 10-60 ms
-    for the load itself). A cached machine-code function needs none of it, so
-    each signature is read from the cache directly (:func:`_load_cached`); only
-    one that is not there is compiled, by ``compile``, which refreshes the
-    context itself. The dispatcher is then closed to compiles, as ``njit`` with
-    signatures does. Only for code compiled without numba's runtime (``_nrt=False``,
-    the kernels' loops): the runtime's symbols are linked in by that refresh, and a
-    loaded function that calls them (a host loop that allocates) would abort.
-    """
-    import numba
-
-    disp = numba.njit(cache=cache, **options)(fn)
-    from numba.core import typeinfer
-
-    direct = cache and options.get("_nrt", True) is False
-    with typeinfer.register_dispatcher(disp):
-        for sig in sigs:
-            if not (direct and _load_cached(disp, sig)):
-                disp.compile(sig)
-    disp.disable_compile()
-    return disp
-
-
-def _load_cached(disp, sig) -> bool:
-    """Add ``sig``'s overload to ``disp`` from numba's disk cache, without the
-    context refresh of ``Dispatcher.compile`` (see :func:`jit_signatures`); False
-    when it is not cached, or numba's internals are not as expected (numba 0.68:
-    then ``compile`` does it the usual way)."""
-    try:
-        from numba.core.compiler_lock import global_compiler_lock
-
-        with global_compiler_lock:
-            cres = disp._cache._load_overload(sig, disp.targetctx)
-            if cres is None or cres.objectmode:
-                return False
-            disp._cache_hits[sig] += 1
-            disp.targetctx.insert_user_function(
-                cres.entry_point, cres.fndesc, [cres.library]
-            )
-            disp.add_overload(cres)
-            return True
-    except Exception:  # noqa: BLE001 - a numba whose internals differ: compile()
-        return False
 
 
 # -- the background loader ---------------------------------------------------------
