@@ -152,9 +152,10 @@ def test_jax_grad_equals_torch(torch, jnp, case, jit):
 
 
 @pytest.mark.exhaustive
-@pytest.mark.parametrize("case", list(CASES))
+@pytest.mark.parametrize("case", [c for c in CASES if "1 m" not in c])
 def test_jax_jit_of_every_case(torch, jnp, case):
     # jit compiles of the alignment's SVD take tens of seconds on a loaded machine.
+    # Pairs in metres need pairs= under tracing (test_traced_poses_need_pairs...).
     _jax_against_torch(torch, jnp, case, True)
 
 
