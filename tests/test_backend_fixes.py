@@ -244,3 +244,83 @@ def test_kinematics_value_checks_still_raise(name, samples):
     err = rk.DegenerateInputError if name.startswith("angular") else rk.ZeroNormError
     with pytest.raises(err, match=r"\(1,\)" if name.startswith("angular") else r"\(2,\)"):
         fn(x)
+
+
+# -- the geodesic (Karcher) mean -----------------------------------------------------------
+
+
+@pytest.fixture
+def spread():
+    return np.random.default_rng(3).normal(scale=0.6, size=(8, 3))
+
+
+def _geodesic_mean(r):
+    return rk.Rotation.from_rotvec(r).mean(method="geodesic").as_rotvec()
+
+
+def test_geodesic_mean_under_jit_vmap_and_grad(spread, jax, jnp, validation):
+    """``float()`` of the step norm broke jit, vmap and grad; the traced loop runs
+    ``max_iter`` steps, each mean frozen once converged, as the eager one stops."""
+    ref = _geodesic_mean(spread)
+    assert np.allclose(jax.jit(_geodesic_mean)(jnp.asarray(spread)), ref, atol=1e-14)
+    if not validation:
+        return
+    both = jax.jit(jax.vmap(_geodesic_mean))(jnp.stack([spread, 0.5 * spread]))
+    assert np.allclose(both[1], _geodesic_mean(0.5 * spread), atol=1e-14)
+    grad = jax.jit(jax.grad(lambda r: _geodesic_mean(r)[1]))
+    g = np.asarray(grad(jnp.asarray(spread)))
+    eps = 1e-6
+    for i, j in [(0, 0), (3, 1), (7, 2)]:
+        d = np.zeros_like(spread)
+        d[i, j] = eps
+        fd = (_geodesic_mean(spread + d)[1] - _geodesic_mean(spread - d)[1]) / (2 * eps)
+        assert np.isclose(g[i, j], fd, rtol=1e-6, atol=1e-9)
+
+
+def test_geodesic_mean_of_transforms_under_jit(jax, jnp):
+    tw = np.random.default_rng(4).normal(scale=0.5, size=(6, 6))
+
+    def mean(x):
+        return rk.Transform.exp(x).mean(method="geodesic").as_matrix()
+
+    assert np.allclose(jax.jit(mean)(jnp.asarray(tw)), mean(tw), atol=1e-13)
+
+
+def test_geodesic_mean_under_torch_func(spread, torch):
+    from torch.func import grad, vmap
+
+    r = torch.tensor(spread)
+    both = vmap(_geodesic_mean)(torch.stack([r, 0.5 * r]))
+    assert np.allclose(both[1].numpy(), _geodesic_mean(0.5 * spread), atol=1e-14)
+    g = grad(lambda x: _geodesic_mean(x)[1])(r)
+    eager = r.clone().requires_grad_()
+    _geodesic_mean(eager)[1].backward()  # the eager loop, which reads the values
+    assert np.allclose(g.numpy(), eager.grad.numpy(), atol=1e-10)
+
+
+@pytest.mark.parametrize(
+    "kw, text",
+    [
+        ({"weights": np.ones(3)}, r"shape \(3,\) does not broadcast to the batch shape"),
+        ({"weights": np.ones((2, 4))}, r"weights: shape \(2, 4\)"),
+        ({"axis": "0"}, "axis must be None, an int or a tuple of ints"),
+        ({"axis": 1.5}, "axis must be None, an int or a tuple of ints"),
+        ({"axis": 1}, "axis 1 is out of bounds for a batch of 1 dimensions"),
+    ],
+)  # fmt: skip
+@pytest.mark.parametrize("method", ["chordal", "geodesic"])
+def test_mean_bad_weights_and_axis_are_shape_errors(kw, text, method):
+    """Issue 20: NumPy's broadcast ValueError and an internal TypeError before."""
+    R = rk.Rotation.random(4, np.random.default_rng(0))
+    with pytest.raises(rk.ShapeError, match=text):
+        R.mean(method=method, **kw)
+    with pytest.raises(rk.ShapeError, match=text):
+        rk.Transform.exp(np.ones((4, 6))).mean(method=method, **kw)
+
+
+def test_mean_bad_weights_on_dask_is_a_shape_error(dask_array):
+    R = rk.Rotation(
+        dask_array.from_array(rk.Rotation.random(4, np.random.default_rng(0)).as_quat())
+    )
+    with pytest.raises(rk.ShapeError, match="weights"):
+        R.mean(weights=np.ones(3))

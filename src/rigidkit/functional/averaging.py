@@ -17,8 +17,9 @@ signs of the input quaternions (``q`` and ``-q`` are one rotation).
 ==============  ===========================================================
 
 Written against the array API (namespace of the input; ``linalg.eigh`` of the
-namespace); the Karcher loop tests convergence on concrete values (NumPy-side),
-so it does not trace under ``jax.jit``.
+namespace); the Karcher loop tests convergence on concrete values, and where
+they cannot be read (``jax.jit``, ``vmap``, ``grad``, ``torch.compile``,
+``torch.func``) it runs ``max_iter`` steps, each mean frozen once converged.
 
 Dask arrays stay lazy: the reduced axes are made whole (one chunk, rechunked) and
 each chunk of the kept batch axes is averaged on its own (one ``map_blocks``-like
@@ -49,11 +50,13 @@ from .._validate import (
     _relabel,
     any_true,
     batch_index,
+    concrete,
     finite_array,
+    to_numpy,
     tolerances,
     where_text,
 )
-from ..errors import ConvergenceWarning, DegenerateInputError
+from ..errors import ConvergenceWarning, DegenerateInputError, ShapeError
 from ..kernels import quaternion as _kq
 from ..kernels import se3 as _kse3
 from ..kernels import so3 as _krv
@@ -72,18 +75,43 @@ __all__ = [
 
 
 def reduce_axes(axis, nbatch):
-    """Batch axes to reduce, as a sorted tuple of non-negative ints (``None``: all)."""
+    """Batch axes to reduce, as a sorted tuple of non-negative ints (``None``: all).
+
+    An axis that is not an integer, or outside the batch, is a
+    :class:`~rigidkit.ShapeError` naming it.
+    """
     if axis is None:
         return tuple(range(nbatch))
-    axes = (axis,) if isinstance(axis, int) else tuple(axis)
+    axes = (axis,) if _is_int(axis) else axis
+    if not isinstance(axes, (tuple, list)) or not all(_is_int(a) for a in axes):
+        raise ShapeError(
+            f"axis must be None, an int or a tuple of ints (batch axes), got {axis!r}"
+        )
     out = []
     for a in axes:
+        a = int(a)
         if not -nbatch <= a < nbatch:
-            raise np.exceptions.AxisError(
+            raise ShapeError(
                 f"axis {a} is out of bounds for a batch of {nbatch} dimensions"
             )
         out.append(a % nbatch)
     return tuple(sorted(set(out)))
+
+
+def _is_int(a):
+    return isinstance(a, (int, np.integer)) and not isinstance(a, (bool, np.bool_))
+
+
+def _check_weights_shape(shape, batch):
+    """:class:`~rigidkit.ShapeError` unless weights of ``shape`` broadcast to ``batch``."""
+    shape = tuple(shape)
+    if len(shape) > len(batch) or any(
+        s not in (1, b) for s, b in zip(shape[::-1], batch[::-1])
+    ):
+        raise ShapeError(
+            f"weights: shape {shape} does not broadcast to the batch shape {tuple(batch)} "
+            "(one weight per element, or a shape that broadcasts to it)"
+        )
 
 
 def _permute(xp, x, order):
@@ -111,6 +139,7 @@ def _weights(xp, weights, batch, axes, like):
     if weights is None:
         return None, None
     w = finite_array(weights, (), "weights")
+    _check_weights_shape(w.shape, batch)
     w = xp.asarray(w, dtype=like.dtype, device=device_of(like))
     w = xp.broadcast_to(w, batch)
     neg = w < 0.0
@@ -220,6 +249,8 @@ def _karcher(xp, mean, g, w, total, method, tol, max_iter, steps):
         raise ValueError(f"method must be 'chordal' or 'geodesic', got {method!r}")
     log_from, retract = steps
     tol = _tol(tol, g.dtype)
+    if not concrete(g):  # traced (jit, vmap, grad, torch.compile, torch.func)
+        return _karcher_traced(xp, mean, g, w, total, tol, max_iter, steps)
     for iterations in range(1, max_iter + 1):
         step = _average(xp, log_from(mean, g), w, total)
         mean = retract(mean, step)
@@ -227,6 +258,40 @@ def _karcher(xp, mean, g, w, total, method, tol, max_iter, steps):
             return mean, iterations
     _warn_unconverged(max_iter, tol)
     return mean, max_iter
+
+
+def _karcher_traced(xp, mean, g, w, total, tol, max_iter, steps):
+    """The Karcher iteration without reading values: ``max_iter`` steps, each mean
+    frozen (``where``) once its own step is below ``tol``, as the eager loop stops.
+
+    On JAX one ``lax.fori_loop`` (a scan: the body traced once, reverse-mode
+    differentiable); elsewhere (torch.compile, torch.func) the steps unrolled.
+    ``iterations`` is then an array: the most steps any mean took (a mean that
+    never converged is not reported under tracing).
+    """
+    log_from, retract = steps
+    tol2 = tol * tol
+
+    def body(_, state):
+        mean, done, count = state
+        step = _average(xp, log_from(mean, g), w, total)
+        new = retract(mean, step)
+        mean = xp.where(done[..., None], mean, new)
+        count = count + xp.where(done, 0.0 * count, 1.0 + 0.0 * count)
+        done = done | (xp.sum(step * step, axis=-1) <= tol2)
+        return mean, done, count
+
+    first = mean[..., 0]
+    state = (mean, first != first, 0.0 * first)  # not done (NaN aside), 0 steps
+    if type(g).__module__.startswith("jax"):
+        import jax
+
+        mean, _, count = jax.lax.fori_loop(0, max_iter, body, state)
+    else:
+        for i in range(max_iter):
+            state = body(i, state)
+        mean, _, count = state
+    return mean, xp.max(count)
 
 
 def lie_steps(compose, inverse, exp, log):
@@ -358,7 +423,7 @@ def quat_mean_unchecked(
     mean, iterations = _karcher(
         xp, _chordal(xp, g, w), g, w, total, method, tol, max_iter, _SO3_STEPS
     )
-    return (_kq.quat_canonical(mean) if iterations else mean), iterations
+    return (_kq.quat_canonical(mean) if method == "geodesic" else mean), iterations
 
 
 def pose_mean(poses, weights=None, *, method="chordal", axis=None, tol=None, max_iter=100):
@@ -406,6 +471,7 @@ def _lazy_mean(fn, x, weights, axis, method, tol, max_iter):
     arrays = [da.transpose(x, order + (nbatch,))]
     if weights is not None:
         w = weights if dask_backend.is_dask(weights) else np.asarray(weights)
+        _check_weights_shape(w.shape, x.shape[:-1])
         arrays.append(da.transpose(da.broadcast_to(w, x.shape[:-1]), order))
     if method in ("chordal", "geodesic") and math.prod(x.shape[a] for a in axes) == 0:
         _check_count(np.zeros((0, 4)), "poses" if x.shape[-1] == 7 else "rotations")
@@ -451,7 +517,8 @@ def _tol(tol, dtype):
 
 
 def _converged(xp, step, tol) -> bool:
-    return float(xp.max(xp.sqrt(xp.sum(step * step, axis=-1)))) <= tol
+    largest = xp.max(xp.sum(step * step, axis=-1))
+    return math.sqrt(float(to_numpy(largest))) <= tol  # detached: no autograd warning
 
 
 def _warn_unconverged(max_iter, tol):
