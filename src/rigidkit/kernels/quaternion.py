@@ -39,12 +39,20 @@ def quat_angle(w, x, y, z):
 
 @kernel(inputs=[(4,), (4,)], outputs=[(4,)])
 def quat_multiply(w1, x1, y1, z1, w2, x2, y2, z2):
-    """Hamilton product ``q1 q2`` (as rotations: ``q2`` first, then ``q1``)."""
+    """Hamilton product ``q1 q2`` (as rotations: ``q2`` first, then ``q1``).
+
+    Each vector component sums its two pairs of terms separately, ``(w1 v2 + v1 w2)
+    + (v1 x v2)``: for ``q1 = q2*`` (or ``q2 = q1*``) each pair is a product minus
+    the same product, exactly 0 in IEEE arithmetic, so ``q* q`` and ``q q*`` have a
+    vector part of exactly 0 (summed left to right it keeps a rounding residue of
+    ~1e-17). The numba loops are compiled without fast-math, so no FMA contraction
+    breaks this.
+    """
     return (
         w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
-        w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-        w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-        w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
+        (w1 * x2 + x1 * w2) + (y1 * z2 - z1 * y2),
+        (w1 * y2 + y1 * w2) + (z1 * x2 - x1 * z2),
+        (w1 * z2 + z1 * w2) + (x1 * y2 - y1 * x2),
     )
 
 
