@@ -7,12 +7,16 @@ coordinates, ``v_A = A_R_B @ v_B``. The world angular velocity has
 -B_R_A hat(omega_A) = -hat(omega_B) B_R_A`` (the spatial and body angular
 velocities of Murray, Li & Sastry 1994, Sec. 2.4.1, and their forms for the
 inverse; pass ``R.inv()`` and negate, or use them as written). Quaternions are
-Hamilton, scalar first: ``q' = q (0, omega_B) / 2 = (0, omega_A) q / 2``.
+Hamilton, scalar first: ``q' = q (0, omega_B) / 2 = (0, omega_A) q / 2``;
+``scalar_first=False`` reads and writes every quaternion array of a call (``q``,
+``q'``, ``q''``) as ``(x, y, z, w)``, the order of scipy, ROS and Eigen.
 """
 
 from __future__ import annotations
 
+from ...functional import conversions as _conv
 from ...kernels.kinematics import rotation as _k
+from ...objects.rotation import Rotation
 from ._common import body_flag, quaternion, rotation_matrix, vector
 
 __all__ = [
@@ -169,7 +173,23 @@ def rotation_second_derivative(R, omega, alpha, *, frame):
     )
 
 
-def quaternion_derivative(q, omega, *, frame):
+def _quat_in(q, scalar_first, what="quaternion"):
+    """Quaternions ``(w, x, y, z)`` from ``q`` given in the order of ``scalar_first``.
+
+    A :class:`~rigidkit.Rotation` carries its own order and is read as it is.
+    """
+    qq = quaternion(q, what)
+    if scalar_first or isinstance(q, Rotation):
+        return qq
+    return _conv.quat_wxyz_from_xyzw(qq)
+
+
+def _quat_out(q, scalar_first):
+    """A quaternion array ``(w, x, y, z)`` in the order of ``scalar_first``."""
+    return q if scalar_first else _conv.quat_xyzw_from_wxyz(q)
+
+
+def quaternion_derivative(q, omega, *, frame, scalar_first=True):
     """``q' = q (0, omega) / 2`` (body) or ``(0, omega) q / 2`` (world), Hamilton.
 
     Parameters
@@ -179,10 +199,14 @@ def quaternion_derivative(q, omega, *, frame):
     omega : array_like, shape (..., 3)
         Angular velocity in ``frame``, radians per unit time.
     frame : {"world", "body"}
+    scalar_first : bool, default True
+        ``False``: ``q`` (an array) and the result are ``(x, y, z, w)``, as
+        scipy's ``as_quat()``.
 
     Returns
     -------
     array, shape (..., 4)
+        ``q'``, in the order of ``scalar_first``.
 
     See Also
     --------
@@ -192,24 +216,31 @@ def quaternion_derivative(q, omega, *, frame):
     --------
     >>> quaternion_derivative([1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 2.0], frame="body")
     array([0., 0., 0., 1.])
+    >>> quaternion_derivative([0, 0, 0, 1.0], [0, 0, 2.0], frame="body", scalar_first=False)
+    array([0., 0., 1., 0.])
     """
     body = body_flag(frame, "quaternion_derivative")
-    return _k.quat_derivative(body, quaternion(q), vector(omega, (3,), "angular velocity"))
+    w = vector(omega, (3,), "angular velocity")
+    return _quat_out(_k.quat_derivative(body, _quat_in(q, scalar_first), w), scalar_first)
 
 
-def quaternion_second_derivative(q, omega, alpha, *, frame):
+def quaternion_second_derivative(q, omega, alpha, *, frame, scalar_first=True):
     """``q'' = q (-|omega|^2/4, alpha/2)`` (body) or ``(-|omega|^2/4, alpha/2) q`` (world).
 
     Parameters
     ----------
     q : Rotation or array_like, shape (..., 4)
+        Quaternions ``(w, x, y, z)``, or ``(x, y, z, w)`` if ``scalar_first=False``.
     omega, alpha : array_like, shape (..., 3)
         Angular velocity and acceleration in ``frame``.
     frame : {"world", "body"}
+    scalar_first : bool, default True
+        ``False``: ``q`` (an array) and the result are ``(x, y, z, w)``.
 
     Returns
     -------
     array, shape (..., 4)
+        ``q''``, in the order of ``scalar_first``.
 
     Examples
     --------
@@ -219,10 +250,11 @@ def quaternion_second_derivative(q, omega, alpha, *, frame):
     body = body_flag(frame, "quaternion_second_derivative")
     w = vector(omega, (3,), "angular velocity")
     a = vector(alpha, (3,), "angular acceleration")
-    return _k.quat_second_derivative(body, quaternion(q), w, a)
+    qdd = _k.quat_second_derivative(body, _quat_in(q, scalar_first), w, a)
+    return _quat_out(qdd, scalar_first)
 
 
-def angular_velocity_from_quaternion_derivative(q, q_dot, *, frame):
+def angular_velocity_from_quaternion_derivative(q, q_dot, *, frame, scalar_first=True):
     """``omega = 2 vec(q* q') / |q|^2`` (body) or ``2 vec(q' q*) / |q|^2`` (world).
 
     Any scale of ``q`` (a changing norm only affects the scalar part).
@@ -233,6 +265,10 @@ def angular_velocity_from_quaternion_derivative(q, q_dot, *, frame):
         Nonzero quaternions ``(w, x, y, z)``.
     q_dot : array_like, shape (..., 4)
     frame : {"world", "body"}
+    scalar_first : bool, default True
+        ``False``: the arrays ``q`` and ``q_dot`` are ``(x, y, z, w)``, as scipy's
+        ``as_quat()`` (``q_dot`` is always an array, so it follows this order even
+        when ``q`` is a :class:`~rigidkit.Rotation`).
 
     Returns
     -------
@@ -249,9 +285,10 @@ def angular_velocity_from_quaternion_derivative(q, q_dot, *, frame):
     >>> angular_velocity_from_quaternion_derivative(q, q_dot, frame="body")
     array([0., 0., 2.])
     """
-    from ...functional import conversions as _conv
-
     body = body_flag(frame, "angular_velocity_from_quaternion_derivative")
-    qq = quaternion(q)
+    qq = _quat_in(q, scalar_first)
     _conv.quat_normalize(qq)  # rejects a zero quaternion, with its batch index
-    return _k.omega_from_quat_derivative(body, qq, vector(q_dot, (4,), "q_dot"))
+    qd = vector(q_dot, (4,), "q_dot")
+    if not scalar_first:
+        qd = _conv.quat_wxyz_from_xyzw(qd)
+    return _k.omega_from_quat_derivative(body, qq, qd)

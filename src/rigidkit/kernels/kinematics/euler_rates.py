@@ -354,3 +354,47 @@ def euler_accelerations_from_alpha(
     p1 = al[e2] - (dc[1] * u1 + dc[4] * u2 + dc[7] * u3)
     p2 = al[m] - (dc[2] * u1 + dc[5] * u2 + dc[8] * u3)
     return rates_from_inverse_rows(reverse, scale, r, p0, p1, p2)
+
+
+@kernel(inputs=[(3,), (3,)], outputs=[(3,)], params=_PARAMS)
+def euler_rates_projected(
+    e1, e2, parity, proper, reverse, body, scale, a0, a1, a2, wx, wy, wz
+):
+    """``E^T @ omega / scale^2`` (sequence order; ``E = scale Q``): the rates of the
+    sequences of one and two axes (the angles padded with zeros, see
+    :func:`~rigidkit.functional.euler.parse_short_sequence`).
+
+    The first one or two columns of ``E`` (the axes of the given turns, each moved
+    by the turns before it or undone by those after it) are orthonormal times
+    ``scale``: consecutive axes are perpendicular and a turn about one axis keeps
+    its neighbour perpendicular to it. Their pseudo-inverse is therefore their
+    transpose over ``scale^2``, and these entries of ``E^T omega / scale^2`` are
+    the least-squares rates, exact where ``omega`` is in their span.
+    """
+    t1, t2, t3 = euler_product_order(reverse, a0 * scale, a1 * scale, a2 * scale)
+    c = euler_rate_columns(parity, proper, body, t1, t2, t3)
+    w = (wx, wy, wz)
+    m = 3 - e1 - e2
+    p0 = w[e1]
+    p1 = w[e2]
+    p2 = w[m]
+    inv = 1.0 / scale  # E^T / scale^2 = Q^T / scale, Q the unit columns
+    u1 = inv * dot3(c[0], c[1], c[2], p0, p1, p2)
+    u2 = inv * dot3(c[3], c[4], c[5], p0, p1, p2)
+    u3 = inv * dot3(c[6], c[7], c[8], p0, p1, p2)
+    rev = reverse == 1
+    return (where(rev, u3, u1), u2, where(rev, u1, u3))
+
+
+@kernel(inputs=[(3,)], outputs=[(3, 3)], params=_PARAMS)
+def rate_matrix_transpose_from_euler(
+    e1, e2, parity, proper, reverse, body, scale, a0, a1, a2
+):
+    """``E^T / scale^2`` (rows in sequence order, columns x, y, z): its first one or
+    two rows are the pseudo-inverse of the rate matrix of a sequence of one or two
+    axes (:func:`euler_rates_projected`)."""
+    t1, t2, t3 = euler_product_order(reverse, a0 * scale, a1 * scale, a2 * scale)
+    c = euler_rate_columns(parity, proper, body, t1, t2, t3)
+    inv = 1.0 / scale
+    e = matrix_entries_from_columns(e1, e2, reverse, inv, c)  # Q^T / scale
+    return (e[0], e[3], e[6], e[1], e[4], e[7], e[2], e[5], e[8])
