@@ -332,8 +332,15 @@ __all__ = sorted(_TOP) + sorted(m for m in _SPACES if m not in _TOP)
 from .symbolic_kinematics import (  # noqa: E402
     euler_matrix,
     euler_rate_matrix,
+    euler_rate_matrix_inverse,
     quaternion_matrix,
     twist_exp,
 )
 
-__all__ += ["euler_matrix", "euler_rate_matrix", "quaternion_matrix", "twist_exp"]
+__all__ += [
+    "euler_matrix",
+    "euler_rate_matrix",
+    "euler_rate_matrix_inverse",
+    "quaternion_matrix",
+    "twist_exp",
+]

@@ -8,6 +8,9 @@ formula computed (and an oracle for tests):
   ``matrix_from_quat``: products of half-angle terms, rewritten in full angles);
 * :func:`euler_rate_matrix` -- ``E`` with ``omega = E d(angles)/dt``
   (``rate_matrix_from_euler``);
+* :func:`euler_rate_matrix_inverse` -- ``E^-1`` with ``d(angles)/dt = E^-1 omega``
+  (``rate_matrix_inverse_from_euler``; the pseudo-inverse ``E^T`` for one or two
+  axes);
 * :func:`quaternion_matrix` -- the matrix of ``v -> q v q^-1`` for any nonzero
   ``q`` (``quat_multiply``, ``quat_conjugate``; ``q^-1 = q* / |q|^2``);
 * :func:`twist_exp` -- ``exp(hat(V) t)`` of a twist ``(v, omega)``
@@ -34,7 +37,7 @@ from fractions import Fraction
 import sympy as sp
 
 from .._engine.primitives import sympy_bindings
-from ..functional.euler import parse_sequence
+from ..functional.euler import parse_sequence, parse_short_sequence
 from ..kernels import euler as _euler
 from ..kernels import matrix as _matrix
 from ..kernels import quaternion as _quat
@@ -42,7 +45,13 @@ from ..kernels import se3 as _se3
 from ..kernels.kinematics import euler_rates as _ke
 from .kinematics._common import body_flag
 
-__all__ = ["euler_matrix", "euler_rate_matrix", "quaternion_matrix", "twist_exp"]
+__all__ = [
+    "euler_matrix",
+    "euler_rate_matrix",
+    "euler_rate_matrix_inverse",
+    "quaternion_matrix",
+    "twist_exp",
+]
 
 
 def _exact(expr):
@@ -161,7 +170,8 @@ def euler_rate_matrix(seq, symbols=None, *, frame):
     Parameters
     ----------
     seq : str
-    symbols : sequence of 3 SymPy expressions, optional
+        Three letters, or one or two (``"ZX"``: ``E`` is 3 x n).
+    symbols : sequence of n SymPy expressions, optional
         The angles in ``seq`` order (default real ``alpha, beta, gamma``).
     frame : {"world", "body"}
 
@@ -179,11 +189,68 @@ def euler_rate_matrix(seq, symbols=None, *, frame):
     [0, -sin(phi), cos(phi)*cos(theta)]])
     """
     body = body_flag(frame, "symbolic.euler_rate_matrix")
-    s = parse_sequence(seq)
-    angles = _symbols(symbols, "alpha beta gamma", 3)
+    s, n, angles, padded = _rate_setup(seq, symbols)
     fn = _ke.rate_matrix_from_euler.bound(_generic_bindings(angles))
-    e = fn(*s.params, body, sp.Integer(1), *angles)
-    return sp.Matrix(3, 3, [sp.expand(_exact(sp.sympify(x))) for x in e])
+    e = fn(*s.params, body, sp.Integer(1), *padded)
+    E = sp.Matrix(3, 3, [sp.expand(_exact(sp.sympify(x))) for x in e])
+    return E[:, :n]
+
+
+def _rate_setup(seq, symbols):
+    """The parsed (padded) sequence, ``n``, its ``n`` symbols and the three angles.
+
+    One or two axes (``"ZX"``) are padded with turns by 0, as ``from_euler`` pads
+    them (:func:`~rigidkit.functional.euler.parse_short_sequence`).
+    """
+    if isinstance(seq, str) and len(seq) == 3:
+        s, n = parse_sequence(seq), 3
+    else:
+        s, n = parse_short_sequence(seq)
+    angles = _symbols(symbols, " ".join(("alpha", "beta", "gamma")[:n]) + ",", n)
+    return s, n, angles, tuple(angles) + (sp.Integer(0),) * (3 - n)
+
+
+def euler_rate_matrix_inverse(seq, symbols=None, *, frame):
+    """``E^-1`` with ``d(angles)/dt = E^-1 @ omega`` over symbols, as ``sympy.Matrix``.
+
+    From the kernel ``rate_matrix_inverse_from_euler`` (rows the angles in ``seq``
+    order, columns ``x, y, z``; ``frame`` as in
+    :func:`rigidkit.kinematics.euler_rate_matrix_inverse`), simplified. It is
+    singular at gimbal lock: the entries divide by ``cos`` (Tait-Bryan) or
+    ``sin`` (proper) of the middle angle. For one or two axes (``"ZX"``), the
+    pseudo-inverse ``E^T`` (n x 3), the columns of ``E`` being orthonormal.
+
+    Parameters
+    ----------
+    seq : str
+    symbols : sequence of n SymPy expressions, optional
+        The angles in ``seq`` order (default real ``alpha, beta, gamma``).
+    frame : {"world", "body"}
+
+    Examples
+    --------
+    The body matrix of intrinsic ``"ZYX"`` (yaw ``psi``, pitch ``theta``, roll
+    ``phi``): the rows ``psi'`` (top) to ``phi'``, from ``omega_body``:
+
+    >>> import sympy as sp
+    >>> phi, theta, psi = sp.symbols("phi theta psi", real=True)
+    >>> euler_rate_matrix_inverse("ZYX", (psi, theta, phi), frame="body")
+    Matrix([
+    [0, sin(phi)/cos(theta), cos(phi)/cos(theta)],
+    [0,            cos(phi),           -sin(phi)],
+    [1, sin(phi)*tan(theta), cos(phi)*tan(theta)]])
+    """
+    body = body_flag(frame, "symbolic.euler_rate_matrix_inverse")
+    s, n, angles, padded = _rate_setup(seq, symbols)
+    bindings = _generic_bindings(angles)
+    if n < 3:
+        fn = _ke.rate_matrix_transpose_from_euler.bound(bindings)
+        e = fn(*s.params, body, sp.Integer(1), *padded)
+    else:
+        fn = _ke.rate_matrix_inverse_from_euler.bound(bindings)
+        e = fn(*s.params, body, sp.Integer(1), *padded)[:9]
+    E = sp.Matrix(3, 3, [sp.simplify(_exact(sp.sympify(x))) for x in e])
+    return E[:n, :]
 
 
 def quaternion_matrix(symbols=None):
