@@ -91,12 +91,22 @@ class Rotation2D(BatchedArray, LieGroup, family="plane", rank=0):
 
     @classmethod
     def from_complex(cls, z):
-        """From nonzero complex numbers ``r e^{iθ}``, shape (...), normalised.
+        """From nonzero complex numbers ``r e^{iθ}``, shape (...): the rotation by ``θ``.
 
-        NumPy (or Python) complex numbers, or a complex torch tensor.
+        The modulus ``r`` is divided out, as :meth:`Rotation.from_quat` divides
+        out a quaternion's norm (and as scipy does): ``3 + 4j`` is the rotation
+        by ``atan2(4, 3)``; keep ``abs(z)`` yourself where the scale matters. A
+        zero raises :class:`~rigidkit.ZeroNormError` (it names no rotation) and
+        NaN or infinity :class:`~rigidkit.NonFiniteError`, naming the batch index.
+        NumPy (or Python) complex numbers, or complex torch, JAX or Dask arrays
+        (kept in their namespace; Dask stays lazy).
 
         >>> float(Rotation2D.from_complex(2j).angle)
         1.5707963267948966
+        >>> Rotation2D.from_complex([3 + 4j, 0j])
+        Traceback (most recent call last):
+        ...
+        rigidkit.errors.ZeroNormError: complex number is zero at batch index (1,); ...
         """
         if is_torch(z):
             import torch
@@ -105,13 +115,16 @@ class Rotation2D(BatchedArray, LieGroup, family="plane", rank=0):
                 raise ShapeError(f"from_complex: expected a complex tensor, got {z.dtype}")
             pairs = torch.stack([z.real, z.imag], dim=-1)
         else:
-            z = np.asarray(z)
-            if z.dtype.kind != "c":
+            if not (hasattr(z, "dtype") and hasattr(z, "real")):
+                z = np.asarray(z)  # Python numbers and lists
+            # JAX, Dask, CuPy: their dtypes are NumPy's; their own real and imag
+            if getattr(z.dtype, "kind", None) != "c":
                 raise ShapeError(
                     f"from_complex: expected complex numbers, got dtype {z.dtype}; "
                     "use Rotation2D(cos_sin) for (..., 2) real pairs"
                 )
-            pairs = np.stack([z.real, z.imag], axis=-1)
+            xp = np if isinstance(z, np.ndarray) else namespace_of(z)
+            pairs = xp.stack([z.real, z.imag], axis=-1)
         return cls._wrap(_so2.complex_normalize(pairs))
 
     @classmethod
