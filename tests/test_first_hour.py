@@ -57,6 +57,21 @@ def test_an_array_where_an_object_is_expected_names_the_constructor(make, hint):
     assert hint in str(err.value)
 
 
+def test_comparisons_take_scipy_objects_and_name_the_constructor_for_arrays():
+    S = SciRot.from_rotvec([[0.1, 0.2, 0.3], [0.0, 0.0, 2.0]])
+    R = rk.Rotation.from_rotvec([[0.1, 0.2, 0.3], [0.0, 0.0, 1.0]])
+    assert R.approx_equal(S).tolist() == [True, False]
+    np.testing.assert_allclose(R.angle_to(S), [0.0, 1.0], atol=1e-12)
+    ref = np.linalg.norm(R.as_matrix() - S.as_matrix(), axis=(-2, -1))
+    np.testing.assert_allclose(R.chordal_distance(S), ref, atol=1e-12)
+    sci_T = SciTransform.from_exp_coords([0.0, 0.0, 0.5, 1.0, 2.0, 3.0])
+    assert bool(rk.Transform.from_matrix(sci_T.as_matrix()).approx_equal(sci_T))
+    with pytest.raises(TypeError, match=r"rk.Rotation.from_matrix\(M\)"):
+        R.approx_equal(np.eye(3))
+    with pytest.raises(TypeError, match=r"rk.Transform.from_matrix\(M\)"):
+        rk.Transform().approx_equal(np.eye(4))
+
+
 def test_an_object_where_an_array_is_expected_says_so():
     with pytest.raises(rk.ShapeError, match="got a rigidkit.Transform object"):
         rk.kinematics.quaternion_derivative(rk.Transform(), np.zeros(3), frame="body")

@@ -195,6 +195,8 @@ class ExtendedPose(BatchedArray, LieGroup, family="navigation", rank=0):
 
     def approx_equal(self, other, *, atol=1e-8):
         """Elementwise: rotation angle, position and velocity gaps all <= ``atol``."""
+        if not isinstance(other, ExtendedPose):
+            other = expect(other, ExtendedPose, "other")
         a, b = self._data, other._data
         angle, dv = pose_gap(a, b)  # the rotation, and the components 4:7 (velocity)
         d = a[..., 7:] - b[..., 7:]

@@ -382,6 +382,8 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
 
         ``q`` and ``-q`` are the same rotation and compare equal.
         """
+        if not isinstance(other, Rotation):
+            other = expect(other, Rotation, "other")
         return _conv.quat_angle_between_unchecked(self._quat, other._quat) <= atol
 
     def angle_to(self, other):
@@ -395,6 +397,8 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
         >>> float(np.round(a.angle_to(Rotation.from_rotvec([0.0, 0.0, -0.25])), 12))
         0.75
         """
+        if not isinstance(other, Rotation):
+            other = expect(other, Rotation, "other")
         return _conv.quat_angle_between_unchecked(self._quat, other._quat)
 
     def chordal_distance(self, other):
@@ -407,6 +411,8 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
         >>> float(np.round(a.chordal_distance(Rotation.from_rotvec([np.pi, 0, 0])), 12))
         2.828427124746
         """
+        if not isinstance(other, Rotation):
+            other = expect(other, Rotation, "other")
         return _dist.chordal_distance_unchecked(self._quat, other._quat)
 
     def swing_twist(self, axis):

@@ -306,6 +306,8 @@ class Transform(BatchedArray, LieGroup, family="space", rank=1):
 
         ``atol`` is in radians for the rotation and in length units for the translation.
         """
+        if not isinstance(other, Transform):
+            other = expect(other, Transform, "other")
         angle, dist = pose_gap(self._pose, other._pose)
         return (angle <= atol) & (dist <= atol)
 
