@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from ...errors import NotARotationError, RigidkitError
+from ...functional import conversions as _conv
 from ...kernels import pose_formats as _kpf
 from ...objects.rotation import Rotation as _RkRotation
 from ..alignment import align_vectors as _align_vectors
@@ -24,6 +25,7 @@ __all__ = ["Rotation", "Slerp"]
 
 _wrap_rk = _RkRotation._wrap
 _quat_from_xyzw = _kpf.quat_from_xyzw
+_axis_angle = _conv.axis_angle_from_quat_unchecked
 _xyzw_from_quat = _kpf.xyzw_from_quat
 _from_quat_rk = _RkRotation.from_quat
 
@@ -380,7 +382,9 @@ class Rotation:
 
     def magnitude(self):
         """Rotation angles in [0, pi], shape (...) (a NumPy scalar for one)."""
-        return scalar(self._r.magnitude())
+        # rk.Rotation.magnitude's kernel, called here: three Python calls fewer
+        # (~0.3 us of ~1.5 us for one rotation).
+        return scalar(_axis_angle(self._r._quat)[1])
 
     def approx_equal(self, other, atol=None, degrees=False):
         """Whether the angle between the rotations is at most ``atol`` (1e-8 rad if
