@@ -324,3 +324,32 @@ def test_mean_bad_weights_on_dask_is_a_shape_error(dask_array):
     )
     with pytest.raises(rk.ShapeError, match="weights"):
         R.mean(weights=np.ones(3))
+
+
+# -- Jacobians on Dask -------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("side", ["right", "left"])
+def test_jacobians_stay_lazy_on_dask(side, dask_array):
+    """compose's identity and plus's Jacobians of a NumPy tangent were NumPy arrays
+    next to a lazy result."""
+    rng = np.random.default_rng(5)
+    a, b, tau = rng.normal(size=(3, 4, 6))
+    calls = {
+        "compose": lambda x, y: rk.jacobians.compose(
+            rk.Transform.exp(x), rk.Transform.exp(y), side=side
+        ),
+        "plus": lambda x, y: rk.jacobians.plus(rk.Transform.exp(x), tau, side=side),
+        "between": lambda x, y: rk.jacobians.between(
+            rk.Transform.exp(x), rk.Transform.exp(y), side=side
+        ),
+    }
+    for name, fn in calls.items():
+        out, computes = lazily(dask_array, fn, a, b)
+        ref = fn(a, b)
+        assert computes == 0, name
+        for got, want in zip(out[1:], ref[1:]):
+            assert isinstance(got, dask_array.Array), name
+            assert got.shape == want.shape
+            assert np.allclose(got.compute(), want, atol=1e-12), name
+        assert np.allclose(out[0].as_matrix().compute(), ref[0].as_matrix(), atol=1e-12)

@@ -77,6 +77,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._engine import dask_backend
 from .._engine.namespace import device_of, namespace_of
 from .._validate import as_array, as_float
 from ..functional import jacobians as _fj
@@ -119,10 +120,28 @@ def _eye(like, n):
     return namespace_of(like).asarray(np.eye(n), dtype=like.dtype, device=device_of(like))
 
 
-def _out(batch, *jacobians):
-    """Each Jacobian broadcast to the value's batch shape (an operand may have fewer)."""
+def _out(value, batch, *jacobians):
+    """Each Jacobian broadcast to the value's batch shape (an operand may have fewer).
+
+    A lazy (Dask) value gets lazy Jacobians: a constant one (the identity, or one
+    from NumPy operands) becomes a Dask array too, chunked as the value's batch.
+    """
+    data = registry.stored(value) if registry.spec(type(value)) is not None else value
+    if dask_backend.is_dask(data):
+        return tuple(_lazy_broadcast(J, tuple(batch), data) for J in jacobians)
     xp = namespace_of(*jacobians)
     return tuple(xp.broadcast_to(J, tuple(batch) + tuple(J.shape[-2:])) for J in jacobians)
+
+
+def _lazy_broadcast(J, batch, data):
+    import dask.array as da
+
+    shape = batch + tuple(J.shape[-2:])
+    if dask_backend.is_dask(J):
+        return da.broadcast_to(J, shape)
+    chunks = tuple(data.chunks[: len(batch)]) + tuple((n,) for n in J.shape[-2:])
+    whole = da.from_array(np.asarray(J), chunks=J.shape)
+    return da.broadcast_to(whole, shape).rechunk(chunks)
 
 
 def compose(X, Y, *, side="right"):
@@ -165,7 +184,7 @@ def compose(X, Y, *, side="right"):
     if left:
         Ad_Z = Z.adjoint()
         J_X, J_Y = _fj.to_left(J_X, Ad_Z, _ad_inv(X)), _fj.to_left(J_Y, Ad_Z, _ad_inv(Y))
-    return (Z, *_out(Z.shape, J_X, J_Y))
+    return (Z, *_out(Z, Z.shape, J_X, J_Y))
 
 
 def inv(X, *, side="right"):
@@ -244,7 +263,7 @@ def apply(X, points, *, side="right"):
     J_X = namespace_of(L).matmul(L, _fj.action_generator(alg.hat, X.dof, d, p))
     if left:
         J_X = _fj.to_left(J_X, None, _ad_inv(X))
-    return (y, *_out(y.shape[:-1], J_X, L))
+    return (y, *_out(y, y.shape[:-1], J_X, L))
 
 
 def log(X, *, side="right"):
@@ -362,7 +381,7 @@ def plus(X, tau, *, side="right"):
     if left:
         Ad_Y = Y.adjoint()
         J_X, J_tau = _fj.to_left(J_X, Ad_Y, _ad_inv(X)), _fj.to_left(J_tau, Ad_Y, None)
-    return (Y, *_out(Y.shape, J_X, J_tau))
+    return (Y, *_out(Y, Y.shape, J_X, J_tau))
 
 
 def minus(X, Y, *, side="right"):
@@ -403,7 +422,7 @@ def minus(X, Y, *, side="right"):
     J_Y = -alg.left_jacobian_inverse(tau)
     if left:
         J_X, J_Y = _fj.to_left(J_X, None, _ad_inv(X)), _fj.to_left(J_Y, None, _ad_inv(Y))
-    return (tau, *_out(tau.shape[:-1], J_X, J_Y))
+    return (tau, *_out(tau, tau.shape[:-1], J_X, J_Y))
 
 
 def between(X, Y, *, side="right"):
@@ -449,4 +468,4 @@ def between(X, Y, *, side="right"):
     if left:
         Ad_Z = Z.adjoint()
         J_X, J_Y = _fj.to_left(J_X, Ad_Z, _ad_inv(X)), _fj.to_left(J_Y, Ad_Z, _ad_inv(Y))
-    return (Z, *_out(Z.shape, J_X, J_Y))
+    return (Z, *_out(Z, Z.shape, J_X, J_Y))
