@@ -269,6 +269,8 @@ def as_array(x, trail: tuple, what: str):
         elif dask_backend.is_dask(x):  # kept lazy: the engine maps kernels over chunks
             if x.dtype.kind not in "fiu":
                 raise ShapeError(f"{what}: expected real numbers, got dtype {x.dtype}")
+        elif type(x) is float or type(x) is int:  # real: no dtype to read (TorchDynamo
+            return _plain_scalar(x, trail, what)  # cannot read a traced ndarray's dtype)
         else:
             x = np.asarray(x)
     if isinstance(x, np.ndarray) and x.dtype.kind not in "fiu":
@@ -281,6 +283,13 @@ def as_array(x, trail: tuple, what: str):
 
 
 _PLAIN = (list, tuple, float, int)
+
+
+def _plain_scalar(x, trail, what):
+    """A Python float or int as a 0-d NumPy array (shape-checked: no trailing axes)."""
+    if trail:
+        raise shape_error(what, (), trail)
+    return np.asarray(x)
 
 
 def scipy_kind(x) -> str | None:
@@ -390,6 +399,9 @@ def _check_finite_numpy(x, trail, what):
 
 def finite_array(x, trail: tuple, what: str):
     """:func:`as_array` then :func:`check_finite`: the check of every user array."""
+    if type(x) is float or type(x) is int:  # checked as a number (TorchDynamo traces
+        check_finite(x, (), what)  # a NumPy array made of it, whose dtype it cannot read)
+        return as_array(x, trail, what)
     x = as_array(x, trail, what)
     check_finite(x, trail, what)
     return x
