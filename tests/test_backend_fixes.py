@@ -353,3 +353,18 @@ def test_jacobians_stay_lazy_on_dask(side, dask_array):
             assert got.shape == want.shape
             assert np.allclose(got.compute(), want, atol=1e-12), name
         assert np.allclose(out[0].as_matrix().compute(), ref[0].as_matrix(), atol=1e-12)
+
+
+def test_twist_from_screw_takes_python_numbers_with_tensors(torch):
+    """A Python pitch and magnitude with torch point and direction raised TypeError
+    (``torch.abs`` of a NumPy array); now they meet the tensors' dtype and device."""
+    q = np.array([1.0, 0.0, 0.0])
+    u = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 1.0]])
+    ref = rk.kinematics.twist_from_screw(q, u, 0.3, 1.2)
+    out = rk.kinematics.twist_from_screw(torch.tensor(q), torch.tensor(u), 0.3, 1.2)
+    assert isinstance(out, torch.Tensor)
+    assert np.allclose(out.numpy(), ref, atol=1e-15)
+    out32 = rk.kinematics.twist_from_screw(
+        torch.tensor(q, dtype=torch.float32), torch.tensor(u, dtype=torch.float32), 0.3, 1.2
+    )
+    assert out32.dtype == torch.float32

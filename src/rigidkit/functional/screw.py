@@ -25,7 +25,8 @@ import math
 
 import numpy as np
 
-from .._engine.namespace import namespace_of
+from .._engine import dask_backend
+from .._engine.namespace import device_of, namespace_of
 from .._validate import as_array, check_finite, finite_array, raise_where
 from ..errors import ZeroNormError
 from ..kernels import screw as _k
@@ -106,6 +107,13 @@ def twist_from_screw(point, direction, pitch, magnitude):
     xp = namespace_of(u)
     if isinstance(u, np.ndarray):
         h = np.asarray(h, dtype=np.result_type(h, u.dtype, np.float32))
+    elif not dask_backend.is_dask(u):  # NumPy (or Python) numbers meet u's namespace
+        q, h, m = (
+            xp.asarray(a, dtype=u.dtype, device=device_of(u))
+            if isinstance(a, np.ndarray)
+            else a
+            for a in (q, h, m)
+        )
     zero = xp.all(u == 0, axis=-1)
     # skipped under tracing and with set_validation(False); on Dask at compute time
     raise_where(zero, ZeroNormError, "screw direction is the zero vector {where}")
