@@ -1,0 +1,615 @@
+"""The cells of the matrix that fail, with the reason (``xfail(strict=True)``).
+
+A fix makes its cell pass, strict xfail turns that into a failure, and the entry
+goes. ``python -m tests.backend_matrix.discover`` lists the failing cells of the
+current tree in this format.
+"""
+
+from __future__ import annotations
+
+# torch.compile(fullgraph=True) in CI: a representative handful (10-30 s each).
+COMPILE_CI = {
+    "rk.so3.exp",
+    "rk.se3.log",
+    "rk.Rotation.apply",
+    "rk.Transform.__matmul__",
+    "rk.kinematics.euler_rates",
+}
+# Further compile cells whose status was recorded from the exhaustive sweep.
+COMPILE_CHECKED: set = set()
+
+FAILS = {
+    ("rk.FrameGraph.__init__", "jit"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[7] at "
+        "applications/frames/buffer.py:as_samples"
+    ),
+    ("rk.FrameGraph.add", "jit"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[7] at "
+        "applications/frames/buffer.py:as_samples"
+    ),
+    ("rk.FrameGraph.get", "jit"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[7] at "
+        "applications/frames/buffer.py:as_samples"
+    ),
+    ("rk.FrameGraph.update_static", "jit"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[7] at "
+        "applications/frames/buffer.py:as_samples"
+    ),
+    ("rk.FrameGraph.velocity", "jit"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[4,7] at "
+        "applications/frames/buffer.py:as_samples"
+    ),
+    ("rk.RotationSpline.__call__", "jit"): (
+        "ConcretizationTypeError: Abstract tracer value encountered where "
+        "concrete value is expected: traced array with shape float64[] at "
+        "functional/splines.py:rotation_spline_coefficients"
+    ),
+    ("rk.RotationSpline.__init__", "jit"): (
+        "ConcretizationTypeError: Abstract tracer value encountered where "
+        "concrete value is expected: traced array with shape float64[] at "
+        "functional/splines.py:rotation_spline_coefficients"
+    ),
+    ("rk.Trajectory.duration", "jit"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[6] at "
+        "applications/trajectory/trajectory.py:check_stamps"
+    ),
+    ("rk.Trajectory.stamps", "jit"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[6] at "
+        "applications/trajectory/trajectory.py:check_stamps"
+    ),
+    ("rk.inertial.split_windows", "jit"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[5,3] at "
+        "applications/inertial/windows.py:split_windows"
+    ),
+    ("rk.trajectory.statistics", "jit"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[6] at "
+        "applications/trajectory/metrics.py:statistics"
+    ),
+    ("rk.Trajectory.duration", "vmap"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[6] at "
+        "applications/trajectory/trajectory.py:check_stamps"
+    ),
+    ("rk.Trajectory.stamps", "vmap"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[6] at "
+        "applications/trajectory/trajectory.py:check_stamps"
+    ),
+    ("rk.inertial.split_windows", "vmap"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[5,3] at "
+        "applications/inertial/windows.py:split_windows"
+    ),
+    ("rk.trajectory.statistics", "vmap"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[6] at "
+        "applications/trajectory/metrics.py:statistics"
+    ),
+    ("rk.Quaternion.__add__", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Quaternion.__mul__", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Quaternion.__rmul__", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Quaternion.__sub__", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Quaternion.concatenate", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Rotation.__pow__", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Rotation.from_axis_angle", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Rotation2D.__matmul__", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Rotation2D.compose", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Rotation2D.concatenate", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Rotation2D.minus", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Rotation2D.plus", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Trajectory.duration", "grad"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[6] at "
+        "applications/trajectory/trajectory.py:check_stamps"
+    ),
+    ("rk.Trajectory.stamps", "grad"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[6] at "
+        "applications/trajectory/trajectory.py:check_stamps"
+    ),
+    ("rk.Transform2D.__matmul__", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Transform2D.compose", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Transform2D.concatenate", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Transform2D.minus", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Transform2D.plus", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.align_points", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.align_vectors", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.conversions.quat_from_axis_angle", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.inertial.split_windows", "grad"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[5,3] at "
+        "applications/inertial/windows.py:split_windows"
+    ),
+    ("rk.kinematics.angular_acceleration_from_euler_rates", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.angular_velocity_from_euler_rates", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.angular_velocity_from_quaternion_derivative", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.euler_accelerations", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.euler_rate_matrix_derivative", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.euler_rates", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.planar.angular_velocity_from_samples", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.planar.integrate_angular_velocity", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.planar.integrate_twist", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.planar.point_acceleration", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.planar.point_velocity", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.planar.rotation_derivative", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.planar.transform_derivative", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.planar.twist_from_samples", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.planar.twist_to_body", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.planar.twist_to_world", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.point_acceleration", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.point_velocity", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.quaternion_derivative", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.quaternion_second_derivative", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.spatial_acceleration_matrix", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.twist_from_screw", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.se2.bracket", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.se23.extpose_from_parts", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.slerp", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.so2.bracket", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.trajectory.statistics", "grad"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[6] at "
+        "applications/trajectory/metrics.py:statistics"
+    ),
+    ("rk.Affine.__getitem__", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Affine.__init__", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Affine.__matmul__", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Affine.apply", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Affine.as_matrix", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Affine.as_projective", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Affine.compose", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Affine.concatenate", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Affine.from_matrix", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Affine.inv", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Affine.matrix", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Affine.reshape", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Affine.translation", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Projective.__getitem__", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Projective.__init__", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Projective.__matmul__", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Projective.apply", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Projective.apply_homogeneous", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Projective.as_matrix", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Projective.as_projective", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Projective.compose", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Projective.concatenate", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Projective.from_affine", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Projective.from_matrix", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Projective.include", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Projective.inv", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Projective.reshape", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead."
+    ),
+    ("rk.Trajectory.duration", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead. at "
+        "applications/trajectory/trajectory.py:check_stamps"
+    ),
+    ("rk.Trajectory.stamps", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead. at "
+        "applications/trajectory/trajectory.py:check_stamps"
+    ),
+    ("rk.inertial.split_windows", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead. at "
+        "applications/inertial/windows.py:split_windows"
+    ),
+    ("rk.trajectory.statistics", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead. at "
+        "applications/trajectory/metrics.py:statistics"
+    ),
+    ("rk.Affine.__getitem__", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Affine.__init__", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Affine.__matmul__", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Affine.apply", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Affine.approx_equal", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Affine.as_matrix", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Affine.as_projective", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Affine.compose", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Affine.concatenate", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Affine.from_matrix", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Affine.inv", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Affine.matrix", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Affine.reshape", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Affine.translation", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Projective.__getitem__", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Projective.__init__", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Projective.__matmul__", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Projective.apply", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Projective.apply_homogeneous", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Projective.approx_equal", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Projective.as_matrix", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Projective.as_projective", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Projective.compose", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Projective.concatenate", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Projective.from_affine", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Projective.from_matrix", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Projective.include", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Projective.inv", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Projective.reshape", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
+    ),
+    ("rk.Trajectory.duration", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
+        "storage at applications/trajectory/trajectory.py:check_stamps"
+    ),
+    ("rk.Trajectory.stamps", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
+        "storage at applications/trajectory/trajectory.py:check_stamps"
+    ),
+    ("rk.inertial.split_windows", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
+        "storage at applications/inertial/windows.py:split_windows"
+    ),
+    ("rk.trajectory.statistics", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
+        "storage at applications/trajectory/metrics.py:statistics"
+    ),
+    ("rk.Affine.__getitem__", "dask"): (
+        "AssertionError: the call computed the graph 2 time(s)"
+    ),
+    ("rk.Affine.__init__", "dask"): (
+        "AssertionError: the call computed the graph 2 time(s)"
+    ),
+    ("rk.Affine.__matmul__", "dask"): (
+        "AssertionError: the call computed the graph 4 time(s)"
+    ),
+    ("rk.Affine.apply", "dask"): ("AssertionError: the call computed the graph 2 time(s)"),
+    ("rk.Affine.approx_equal", "dask"): (
+        "AssertionError: the call computed the graph 4 time(s)"
+    ),
+    ("rk.Affine.as_matrix", "dask"): (
+        "AssertionError: the call computed the graph 2 time(s)"
+    ),
+    ("rk.Affine.as_projective", "dask"): (
+        "AssertionError: the call computed the graph 2 time(s)"
+    ),
+    ("rk.Affine.compose", "dask"): (
+        "AssertionError: the call computed the graph 4 time(s)"
+    ),
+    ("rk.Affine.concatenate", "dask"): (
+        "AssertionError: the call computed the graph 4 time(s)"
+    ),
+    ("rk.Affine.from_matrix", "dask"): (
+        "AssertionError: the call computed the graph 2 time(s)"
+    ),
+    ("rk.Affine.inv", "dask"): ("AssertionError: the call computed the graph 2 time(s)"),
+    ("rk.Affine.matrix", "dask"): ("AssertionError: the call computed the graph 2 time(s)"),
+    ("rk.Affine.reshape", "dask"): (
+        "AssertionError: the call computed the graph 2 time(s)"
+    ),
+    ("rk.Affine.translation", "dask"): (
+        "AssertionError: the call computed the graph 2 time(s)"
+    ),
+    ("rk.Projective.from_affine", "dask"): (
+        "AssertionError: the call computed the graph 2 time(s)"
+    ),
+    ("rk.Projective.include", "dask"): (
+        "AssertionError: the call computed the graph 2 time(s)"
+    ),
+    ("rk.Quaternion.__rmul__", "dask"): (
+        "AssertionError: the call computed the graph 1 time(s)"
+    ),
+    ("rk.Quaternion.__truediv__", "dask"): (
+        "AssertionError: the call computed the graph 1 time(s)"
+    ),
+    ("rk.Quaternion.from_parts", "dask"): (
+        "AssertionError: the call computed the graph 2 time(s)"
+    ),
+    ("rk.Rotation2D.as_complex", "dask"): (
+        "AssertionError: the call computed the graph 2 time(s)"
+    ),
+    ("rk.Trajectory.duration", "dask"): (
+        "AssertionError: the call computed the graph 1 time(s)"
+    ),
+    ("rk.Trajectory.stamps", "dask"): (
+        "AssertionError: the call computed the graph 1 time(s)"
+    ),
+    ("rk.inertial.split_windows", "dask"): (
+        "AssertionError: the call computed the graph 2 time(s)"
+    ),
+    ("rk.kinematics.planar.integrate_angular_velocity", "dask"): (
+        "AssertionError: the call computed the graph 1 time(s)"
+    ),
+    ("rk.kinematics.planar.integrate_twist", "dask"): (
+        "AssertionError: the call computed the graph 1 time(s)"
+    ),
+    ("rk.sim3.left_jacobian_inverse", "dask"): (
+        "ValueError: Dimension must be 2 to perform lu decomposition at "
+        "functional/sim3.py:_left_jacobian_inverse"
+    ),
+    ("rk.sim3.right_jacobian_inverse", "dask"): (
+        "ValueError: Dimension must be 2 to perform lu decomposition at "
+        "functional/sim3.py:_left_jacobian_inverse"
+    ),
+    ("rk.trajectory.statistics", "dask"): (
+        "AssertionError: the call computed the graph 1 time(s)"
+    ),
+    ("rk.Transform.__matmul__", "compile"): (
+        "Unsupported: Failed to trace builtin operator (torch.compile fullgraph)"
+    ),
+}
