@@ -110,9 +110,9 @@ def rates_at_step_points(rate, h, *, order: int):
     if h.ndim == 0 and n > m:
         return _uniform(rate, n, m, conv, rows, xp)
     if h.ndim == 0:  # uniform, n == m: unit steps give the same weights
-        d = np.ones(n)
-        hx = np
-    elif isinstance(h, np.ndarray):
+        j0, w_mid, w_end = _SHORT[m]
+        return _apply(j0, conv(w_mid), conv(w_end), rows, m)
+    if isinstance(h, np.ndarray):
         d = h.astype(np.float64)
         hx = np
     else:
@@ -123,6 +123,11 @@ def rates_at_step_points(rate, h, *, order: int):
     j0, offs = _node_offsets(d, m, hx)
     w_mid = conv(_lagrange(offs, 0.5 * d, hx))
     w_end = conv(_lagrange(offs, d, hx))
+    return _apply(j0, w_mid, w_end, rows, m)
+
+
+def _apply(j0, w_mid, w_end, rows, m):
+    """``sum_i w[..., i] rate[j0 + i]`` at the middle and the end of each step."""
     mid = 0.0
     end = 0.0
     for i in range(m):
@@ -141,10 +146,7 @@ def _uniform(rate, n, m, conv, rows, xp):
     ``k + 1``.
     """
     small = m + 1  # every window position occurs in m + 1 unit steps
-    d = np.ones(small)
-    j0, offs = _node_offsets(d, m)
-    w_mid = _lagrange(offs, 0.5 * d)  # (small, m)
-    w_end = _lagrange(offs, d)
+    w_mid, w_end = _UNIFORM[m]  # (small, m)
     lead = m // 2 - 1  # steps before the first interior one
     inner = w_mid[lead]
     count = n - m + 1  # interior steps: k = lead ... lead + count - 1
@@ -152,11 +154,11 @@ def _uniform(rate, n, m, conv, rows, xp):
     for i in range(m):
         mid_inner = mid_inner + float(inner[i]) * rate[..., i : i + count, :]
     pieces = []
-    head = rows(np.arange(m))
+    head = rate[..., :m, :]
     for k in range(lead):
         pieces.append(_weighted(w_mid[k], head, conv))
     pieces.append(mid_inner)
-    tail = rows(np.arange(n - m, n))
+    tail = rate[..., n - m :, :]
     for c in range(lead + 1, m):  # the last m - lead - 1 steps, window at the end
         pieces.append(_weighted(w_mid[small - m + c], tail, conv))
     mid = xp.concat(pieces, axis=-2)
@@ -171,3 +173,17 @@ def _weighted(w, nodes, conv):
     for i in range(nodes.shape[-2]):
         out = out + float(w[i]) * nodes[..., i : i + 1, :]
     return out
+
+
+def _unit_weights(n, m):
+    """``(j0, w_mid, w_end)`` of ``n`` unit steps (NumPy, made once at import)."""
+    d = np.ones(n)
+    j0, offs = _node_offsets(d, m)
+    return j0, _lagrange(offs, 0.5 * d), _lagrange(offs, d)
+
+
+# Uniform steps need no values of the steps: their weights are constants, made
+# here once (as Python floats for the interior windows), so that nothing NumPy
+# runs in a traced call (TorchDynamo cannot trace reading a NumPy array's dtype).
+_SHORT = {m: _unit_weights(m, m) for m in (2, 4)}
+_UNIFORM = {m: tuple(w.tolist() for w in _unit_weights(m + 1, m)[1:]) for m in (2, 4)}
