@@ -158,8 +158,15 @@ def test_coming_from_ros_the_wrong_order_is_visible():
 def test_coming_from_scipy_examples_agree_with_scipy():
     ns: dict = {}
     exec("import numpy as np\nimport rigidkit as rk\n", ns)
-    (block,) = re.findall(r"```python\n(.*?)```", _section("### Coming from scipy"), re.S)
-    exec(block, ns)
+    blocks = re.findall(r"```python\n(.*?)```", _section("### Coming from scipy"), re.S)
+    assert len(blocks) == 2
+    for block in blocks:
+        exec(block, ns)
+    # The drop-in: scipy's API and order, the rotation of rigidkit's R12 (q or -q).
+    ref = (ns["S1"] * ns["S2"]).as_quat()
+    q = ns["q_xyzw"]
+    np.testing.assert_allclose(q * np.sign(q @ ref), ref, atol=1e-15)
+    assert ns["R2"].approx_equal(ns["R12"], atol=1e-15)
     S1, S2 = ns["S1"], ns["S2"]
     np.testing.assert_allclose(ns["R12"].as_matrix(), (S1 * S2).as_matrix(), atol=1e-15)
     np.testing.assert_allclose(ns["q_rk"], np.roll(ns["q_scipy"], 1), atol=1e-15)
