@@ -32,6 +32,7 @@ bindings of the same kernel:
 
 from __future__ import annotations
 
+import math
 import os
 
 import numpy as np
@@ -41,6 +42,7 @@ from ..._engine import (
     idle_workers,
     in_background,
     is_numpy,
+    is_torch,
     namespace_of,
     numba_available,
     run_split,
@@ -107,8 +109,9 @@ def running_product(chain, body: int, x0, inc):
     xp = namespace_of(x0, inc)
     width = inc.shape[-1]
     steps = inc.shape[-2]
-    batch = tuple(np.broadcast_shapes(tuple(x0.shape[:-1]), tuple(inc.shape[:-2])))
-    n = int(np.prod(batch, dtype=np.int64))
+    # plain Python on the shapes: nothing NumPy runs in a call torch.compile traces
+    batch = _broadcast(tuple(x0.shape[:-1]), tuple(inc.shape[:-2]))
+    n = math.prod(batch)
     if is_numpy(xp) and isinstance(inc, np.ndarray) and n * steps >= COMPILE_MIN:
         dtype = np.result_type(x0.dtype, inc.dtype)
         key = (chain.name, width, dtype.char)
@@ -117,9 +120,19 @@ def running_product(chain, body: int, x0, inc):
             return _numba_product(scan, body, x0, inc, batch, n, steps, width, dtype)
         prepare(chain, x0, inc, steps)
         return _chunked_product(chain, body, key, x0, inc, batch, n, steps, dtype)
-    if type(inc).__module__.startswith("jax") or type(x0).__module__.startswith("jax"):
+    if not is_torch(inc) and (
+        type(inc).__module__.startswith("jax") or type(x0).__module__.startswith("jax")
+    ):
         return _jax_prefix()(chain, int(body), x0, inc, batch)
     return _prefix_product(chain, body, x0, inc, batch, xp)
+
+
+def _broadcast(a: tuple, b: tuple) -> tuple:
+    """``np.broadcast_shapes(a, b)`` in plain Python (the shapes broadcast)."""
+    n = max(len(a), len(b))
+    a = (1,) * (n - len(a)) + a
+    b = (1,) * (n - len(b)) + b
+    return tuple(y if x == 1 else x for x, y in zip(a, b))
 
 
 _JAX_PREFIX = None
