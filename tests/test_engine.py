@@ -525,6 +525,8 @@ PARAM_SAMPLERS = {
     "kinematics.euler_rates.euler_rates_from_omega": _euler_rates(1),
     "kinematics.euler_rates.alpha_from_euler_accelerations": _euler_rates(2),
     "kinematics.euler_rates.euler_accelerations_from_alpha": _euler_rates(2),
+    "kinematics.euler_rates.rate_matrix_transpose_from_euler": _euler_rates(0),
+    "kinematics.euler_rates.euler_rates_projected": _euler_rates(1),
     # Integration steps: rates at start, middle and end, steps of 1e-4 ... 1.
     "kinematics.integration.so3_chain": _kin(
         lambda rng, n: [_unit(rng, n, 4), _unit(rng, n, 4)]
