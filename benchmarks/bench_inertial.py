@@ -184,6 +184,8 @@ def preintegration_rows(rk, repeat, notes):
             vs = f"{C.fmt(ratio)}x gtsam" + (
                 "" if ratio >= GTSAM_TARGET else " (below target)"
             )
+            if "pypose" in per:
+                vs += f", {C.fmt(per['pypose'] / ns)}x pypose"
         rows.append(
             [
                 f"preintegrate {name}" if name in fns else name,
