@@ -865,7 +865,7 @@ _p = _i + "Preintegrated."
 ex(_p + "__init__", lambda g, a: _pim(g, a).covariance, *_IMU)
 ex(
     _p + "corrected",
-    lambda g, a: _pim(g, a).corrected(0.01 + 0 * g[0], 0.1 + 0 * a[0]),
+    lambda g, a: _pim(g, a).corrected(0.01 + 0 * g[..., 0, :], 0.1 + 0 * a[..., 0, :]),
     *_IMU,
 )
 ex(_p + "predict", lambda g, a, x: _pim(g, a).predict(_X(x)).as_matrix(), *_IMU, V(9))

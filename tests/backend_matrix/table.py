@@ -15,8 +15,9 @@ from . import examples, status
 
 DOC = pathlib.Path(__file__).resolve().parents[2] / "docs" / "backends.md"
 COLUMNS = {
-    "jax.jit": "the call traces under `jax.jit` (`jax.make_jaxpr`) and the traced "
-    "program gives NumPy's values",
+    "jax.jit": "the call traces under `jax.jit` (`jax.make_jaxpr`) with NumPy's output "
+    "shapes (values: the vmap cell evaluates that program; `RIGIDKIT_MATRIX_XLA=1` "
+    "compiles and compares every JAX cell with XLA)",
     "jax.vmap": "`jax.vmap` over two inputs equals the two NumPy calls",
     "jax.grad": "`jax.grad` of a fixed random weighting of the outputs equals central "
     "finite differences (step 1e-6)",
