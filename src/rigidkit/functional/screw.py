@@ -104,15 +104,16 @@ def twist_from_screw(point, direction, pitch, magnitude):
     u = finite_array(direction, (3,), "screw direction")
     m = finite_array(magnitude, (), "screw magnitude")
     h = as_array(pitch, (), "screw pitch")
-    xp = namespace_of(u)
-    if isinstance(u, np.ndarray):
+    xp = namespace_of(u, q, h, m)
+    like = next((a for a in (u, q, h, m) if not isinstance(a, np.ndarray)), None)
+    if like is None:
         h = np.asarray(h, dtype=np.result_type(h, u.dtype, np.float32))
-    elif not dask_backend.is_dask(u):  # NumPy (or Python) numbers meet u's namespace
-        q, h, m = (
-            xp.asarray(a, dtype=u.dtype, device=device_of(u))
+    elif not dask_backend.any_dask(u, q, h, m):  # NumPy numbers meet the others
+        q, u, h, m = (
+            xp.asarray(a, dtype=like.dtype, device=device_of(like))
             if isinstance(a, np.ndarray)
             else a
-            for a in (q, h, m)
+            for a in (q, u, h, m)
         )
     zero = xp.all(u == 0, axis=-1)
     # skipped under tracing and with set_validation(False); on Dask at compute time
