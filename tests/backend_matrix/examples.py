@@ -1059,7 +1059,7 @@ _COV = np.diag([0.01, 0.02, 0.03, 0.001, 0.002, 0.003])
 
 
 def _ut(x, c):
-    return rk.UncertainTransform(T_(x), _COV * (1.0 + c))
+    return rk.UncertainTransform(T_(x), (1.0 + c) * _COV)
 
 
 ex(_u + "__init__", lambda x, c: _ut(x, c).cov, V(6), S())

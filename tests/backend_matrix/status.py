@@ -142,10 +142,67 @@ FAILS = {
         "__array__() was called on traced array with shape float64[5,3] at "
         "applications/inertial/windows.py:split_windows"
     ),
+    ("rk.inertial.states_from_trajectory", "vmap"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[3,6] at "
+        "applications/inertial/simulation.py:states_from_trajectory"
+    ),
+    ("rk.trajectory.align", "vmap"): (
+        "AttributeError: 'tuple' object has no attribute 'as_matrix'"
+    ),
     ("rk.trajectory.statistics", "vmap"): (
         "TracerArrayConversionError: The numpy.ndarray conversion method "
         "__array__() was called on traced array with shape float64[6] at "
         "applications/trajectory/metrics.py:statistics"
+    ),
+    ("rk.BSplineSE3.__call__", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.ExtendedPose.__matmul__", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.ExtendedPose.compose", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.ExtendedPose.concatenate", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.ExtendedPose.minus", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.ExtendedPose.plus", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.FrameGraph.__init__", "grad"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[7] at "
+        "applications/frames/buffer.py:as_samples"
+    ),
+    ("rk.FrameGraph.add", "grad"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[7] at "
+        "applications/frames/buffer.py:as_samples"
+    ),
+    ("rk.FrameGraph.get", "grad"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[7] at "
+        "applications/frames/buffer.py:as_samples"
+    ),
+    ("rk.FrameGraph.update_static", "grad"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[7] at "
+        "applications/frames/buffer.py:as_samples"
+    ),
+    ("rk.FrameGraph.velocity", "grad"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[4,7] at "
+        "applications/frames/buffer.py:as_samples"
     ),
     ("rk.Quaternion.__add__", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
@@ -175,6 +232,10 @@ FAILS = {
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
+    ("rk.Rotation.plus", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
     ("rk.Rotation2D.__matmul__", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
@@ -195,6 +256,36 @@ FAILS = {
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
+    ("rk.RotationSpline.__call__", "grad"): (
+        "ConcretizationTypeError: Abstract tracer value encountered where "
+        "concrete value is expected: traced array with shape float64[] at "
+        "functional/splines.py:rotation_spline_coefficients"
+    ),
+    ("rk.RotationSpline.__init__", "grad"): (
+        "ConcretizationTypeError: Abstract tracer value encountered where "
+        "concrete value is expected: traced array with shape float64[] at "
+        "functional/splines.py:rotation_spline_coefficients"
+    ),
+    ("rk.Similarity.__matmul__", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Similarity.compose", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Similarity.concatenate", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Similarity.minus", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Similarity.plus", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
     ("rk.Trajectory.duration", "grad"): (
         "TracerArrayConversionError: The numpy.ndarray conversion method "
         "__array__() was called on traced array with shape float64[6] at "
@@ -204,6 +295,22 @@ FAILS = {
         "TracerArrayConversionError: The numpy.ndarray conversion method "
         "__array__() was called on traced array with shape float64[6] at "
         "applications/trajectory/trajectory.py:check_stamps"
+    ),
+    ("rk.Trajectory.transform", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Transform.__matmul__", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Transform.concatenate", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Transform.plus", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
     ),
     ("rk.Transform2D.__matmul__", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
@@ -225,6 +332,10 @@ FAILS = {
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
+    ("rk.UncertainTransform.between", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
     ("rk.align_points", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
@@ -237,9 +348,34 @@ FAILS = {
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
+    ("rk.inertial.Preintegrated.__init__", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
     ("rk.inertial.Preintegrated.corrected", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.inertial.Preintegrated.delta_R", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.inertial.Preintegrated.delta_t", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.inertial.Preintegrated.jacobian_accel_bias", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.inertial.Preintegrated.predict", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.inertial.imu_from_trajectory", "grad"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[3,6] at "
+        "applications/inertial/simulation.py:_pose_and_twists"
     ),
     ("rk.inertial.preintegrate", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
@@ -262,6 +398,10 @@ FAILS = {
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
+    ("rk.kinematics.angular_velocity_from_samples", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
     ("rk.kinematics.euler_accelerations", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
@@ -271,6 +411,14 @@ FAILS = {
         "array with shape bool[]. at _validate.py:check_finite"
     ),
     ("rk.kinematics.euler_rates", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.integrate_angular_velocity[rk4]", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.integrate_twist[midpoint]", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
@@ -330,11 +478,27 @@ FAILS = {
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
+    ("rk.kinematics.rotation_second_derivative", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
     ("rk.kinematics.spatial_acceleration_matrix", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
+    ("rk.kinematics.transform_second_derivative", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.twist_from_samples", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
     ("rk.kinematics.twist_from_screw", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.twist_to_world", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
@@ -346,11 +510,23 @@ FAILS = {
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
+    ("rk.se3.pose_distance", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
     ("rk.slerp", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
     ("rk.so2.bracket", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.trajectory.ape", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.trajectory.rpe", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
@@ -410,6 +586,31 @@ FAILS = {
     ("rk.Affine.translation", "torch_grad"): (
         "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
         "tensor.detach().numpy() instead."
+    ),
+    ("rk.FrameGraph.__init__", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead. at "
+        "applications/frames/buffer.py:as_samples"
+    ),
+    ("rk.FrameGraph.add", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead. at "
+        "applications/frames/buffer.py:as_samples"
+    ),
+    ("rk.FrameGraph.get", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead. at "
+        "applications/frames/buffer.py:as_samples"
+    ),
+    ("rk.FrameGraph.update_static", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead. at "
+        "applications/frames/buffer.py:as_samples"
+    ),
+    ("rk.FrameGraph.velocity", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead. at "
+        "applications/frames/buffer.py:as_samples"
     ),
     ("rk.Projective.__getitem__", "torch_grad"): (
         "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
@@ -477,10 +678,23 @@ FAILS = {
         "tensor.detach().numpy() instead. at "
         "applications/trajectory/trajectory.py:check_stamps"
     ),
+    ("rk.inertial.imu_from_trajectory", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead. at "
+        "applications/inertial/simulation.py:_pose_and_twists"
+    ),
     ("rk.inertial.split_windows", "torch_grad"): (
         "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
         "tensor.detach().numpy() instead. at "
         "applications/inertial/windows.py:split_windows"
+    ),
+    ("rk.inertial.states_from_trajectory", "torch_grad"): (
+        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
+        "tensor.detach().numpy() instead. at "
+        "applications/inertial/simulation.py:states_from_trajectory"
+    ),
+    ("rk.trajectory.align", "torch_grad"): (
+        "AttributeError: 'tuple' object has no attribute 'as_matrix'"
     ),
     ("rk.trajectory.statistics", "torch_grad"): (
         "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
@@ -529,6 +743,26 @@ FAILS = {
     ("rk.Affine.translation", "torch_vmap"): (
         "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
     ),
+    ("rk.FrameGraph.__init__", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
+        "storage at applications/frames/buffer.py:as_samples"
+    ),
+    ("rk.FrameGraph.add", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
+        "storage at applications/frames/buffer.py:as_samples"
+    ),
+    ("rk.FrameGraph.get", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
+        "storage at applications/frames/buffer.py:as_samples"
+    ),
+    ("rk.FrameGraph.update_static", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
+        "storage at applications/frames/buffer.py:as_samples"
+    ),
+    ("rk.FrameGraph.velocity", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
+        "storage at applications/frames/buffer.py:as_samples"
+    ),
     ("rk.Projective.__getitem__", "torch_vmap"): (
         "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
     ),
@@ -574,6 +808,11 @@ FAILS = {
     ("rk.Projective.reshape", "torch_vmap"): (
         "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
     ),
+    ("rk.RotationSpline.__init__", "torch_vmap"): (
+        "RuntimeError: vmap: It looks like you're calling .item() on a Tensor. "
+        "We don't support vmap over calling .item() on a Tensor, please try to "
+        "rewrite what y at functional/splines.py:rotation_spline_coefficients"
+    ),
     ("rk.Trajectory.duration", "torch_vmap"): (
         "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
         "storage at applications/trajectory/trajectory.py:check_stamps"
@@ -582,9 +821,20 @@ FAILS = {
         "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
         "storage at applications/trajectory/trajectory.py:check_stamps"
     ),
+    ("rk.inertial.imu_from_trajectory", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
+        "storage at applications/inertial/simulation.py:_pose_and_twists"
+    ),
     ("rk.inertial.split_windows", "torch_vmap"): (
         "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
         "storage at applications/inertial/windows.py:split_windows"
+    ),
+    ("rk.inertial.states_from_trajectory", "torch_vmap"): (
+        "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
+        "storage at applications/inertial/simulation.py:states_from_trajectory"
+    ),
+    ("rk.trajectory.align", "torch_vmap"): (
+        "AttributeError: 'tuple' object has no attribute 'as_matrix'"
     ),
     ("rk.trajectory.statistics", "torch_vmap"): (
         "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
@@ -626,6 +876,33 @@ FAILS = {
     ("rk.Affine.translation", "dask"): (
         "AssertionError: the call computed the graph 2 time(s)"
     ),
+    ("rk.ExtendedPose.from_matrix", "dask"): (
+        "TypeError: '>=' not supported between instances of 'tuple' and 'int' "
+        "at functional/se23.py:extpose_from_matrix"
+    ),
+    ("rk.FrameGraph.__init__", "dask"): (
+        "ShapeError: a static edge takes one pose, got a batch of shape (2,); "
+        "pass stamps= for a dynamic edge at "
+        "applications/frames/buffer.py:as_samples"
+    ),
+    ("rk.FrameGraph.add", "dask"): (
+        "ShapeError: a static edge takes one pose, got a batch of shape (2,); "
+        "pass stamps= for a dynamic edge at "
+        "applications/frames/buffer.py:as_samples"
+    ),
+    ("rk.FrameGraph.get", "dask"): (
+        "ShapeError: a static edge takes one pose, got a batch of shape (2,); "
+        "pass stamps= for a dynamic edge at "
+        "applications/frames/buffer.py:as_samples"
+    ),
+    ("rk.FrameGraph.update_static", "dask"): (
+        "ShapeError: a static edge takes one pose, got a batch of shape (2,); "
+        "pass stamps= for a dynamic edge at "
+        "applications/frames/buffer.py:as_samples"
+    ),
+    ("rk.FrameGraph.velocity", "dask"): (
+        "AssertionError: the call computed the graph 1 time(s)"
+    ),
     ("rk.Projective.from_affine", "dask"): (
         "AssertionError: the call computed the graph 2 time(s)"
     ),
@@ -650,8 +927,23 @@ FAILS = {
     ("rk.Trajectory.stamps", "dask"): (
         "AssertionError: the call computed the graph 1 time(s)"
     ),
+    ("rk.conversions.nearest_rotation_matrix", "dask"): (
+        "ValueError: Array must be 2D. at functional/conversions.py:nearest_rotation_matrix"
+    ),
     ("rk.inertial.Preintegrated.corrected", "dask"): (
         "AssertionError: the call computed the graph 2 time(s)"
+    ),
+    ("rk.inertial.Preintegrated.residual", "dask"): (
+        "ValueError: all the input arrays must have same number of dimensions, "
+        "but the array at index 0 has 2 dimension(s) and the array at index 1 "
+        "has 3 dimensi at applications/inertial/preintegration.py:<listcomp>"
+    ),
+    ("rk.inertial.imu_from_trajectory", "dask"): (
+        "DegenerateInputError: control_points: 2 given, at least 4 needed at "
+        "applications/interpolation.py:keyframe_kind"
+    ),
+    ("rk.inertial.integrate", "dask"): (
+        "AssertionError: the call computed the graph 1 time(s)"
     ),
     ("rk.inertial.preintegrate", "dask"): (
         "AssertionError: outputs returned computed, not lazily: ['ndarray', 'ndarray']"
@@ -659,11 +951,39 @@ FAILS = {
     ("rk.inertial.split_windows", "dask"): (
         "AssertionError: the call computed the graph 2 time(s)"
     ),
+    ("rk.inertial.states_from_trajectory", "dask"): (
+        "DegenerateInputError: control_points: 2 given, at least 4 needed at "
+        "applications/interpolation.py:keyframe_kind"
+    ),
+    ("rk.kinematics.integrate_angular_velocity", "dask"): (
+        "AssertionError: the call computed the graph 1 time(s)"
+    ),
+    ("rk.kinematics.integrate_angular_velocity[rk4]", "dask"): (
+        "AssertionError: the call computed the graph 1 time(s)"
+    ),
+    ("rk.kinematics.integrate_twist", "dask"): (
+        "AssertionError: the call computed the graph 1 time(s)"
+    ),
+    ("rk.kinematics.integrate_twist[midpoint]", "dask"): (
+        "AssertionError: the call computed the graph 1 time(s)"
+    ),
     ("rk.kinematics.planar.integrate_angular_velocity", "dask"): (
         "AssertionError: the call computed the graph 1 time(s)"
     ),
     ("rk.kinematics.planar.integrate_twist", "dask"): (
         "AssertionError: the call computed the graph 1 time(s)"
+    ),
+    ("rk.se23.adjoint", "dask"): (
+        "TypeError: '>=' not supported between instances of 'tuple' and 'int' "
+        "at functional/se23.py:extpose_from_matrix"
+    ),
+    ("rk.se23.extpose_from_matrix", "dask"): (
+        "TypeError: '>=' not supported between instances of 'tuple' and 'int' "
+        "at functional/se23.py:extpose_from_matrix"
+    ),
+    ("rk.se23.log", "dask"): (
+        "TypeError: '>=' not supported between instances of 'tuple' and 'int' "
+        "at functional/se23.py:extpose_from_matrix"
     ),
     ("rk.sim3.left_jacobian_inverse", "dask"): (
         "ValueError: Dimension must be 2 to perform lu decomposition at "
@@ -672,6 +992,18 @@ FAILS = {
     ("rk.sim3.right_jacobian_inverse", "dask"): (
         "ValueError: Dimension must be 2 to perform lu decomposition at "
         "functional/sim3.py:_left_jacobian_inverse"
+    ),
+    ("rk.trajectory.align", "dask"): (
+        "AttributeError: 'tuple' object has no attribute 'as_matrix'"
+    ),
+    ("rk.trajectory.ape", "dask"): (
+        "AssertionError: the call computed the graph 2 time(s)"
+    ),
+    ("rk.trajectory.pair_indices", "dask"): (
+        "AssertionError: the call computed the graph 1 time(s)"
+    ),
+    ("rk.trajectory.rpe", "dask"): (
+        "AssertionError: the call computed the graph 2 time(s)"
     ),
     ("rk.trajectory.statistics", "dask"): (
         "AssertionError: the call computed the graph 1 time(s)"
