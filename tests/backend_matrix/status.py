@@ -304,7 +304,27 @@ FAILS = {
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
+    ("rk.Transform.__pow__", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Transform.compose", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
     ("rk.Transform.concatenate", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Transform.distance_to", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Transform.from_screw", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.Transform.minus", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
@@ -348,6 +368,10 @@ FAILS = {
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
+    ("rk.inertial.Preintegrated.__getitem__", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
     ("rk.inertial.Preintegrated.__init__", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
@@ -360,7 +384,15 @@ FAILS = {
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
+    ("rk.inertial.Preintegrated.delta_p", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
     ("rk.inertial.Preintegrated.delta_t", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.inertial.Preintegrated.delta_v", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
@@ -368,7 +400,15 @@ FAILS = {
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
+    ("rk.inertial.Preintegrated.jacobian_gyro_bias", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
     ("rk.inertial.Preintegrated.predict", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.inertial.Preintegrated.residual", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
@@ -376,6 +416,10 @@ FAILS = {
         "TracerArrayConversionError: The numpy.ndarray conversion method "
         "__array__() was called on traced array with shape float64[3,6] at "
         "applications/inertial/simulation.py:_pose_and_twists"
+    ),
+    ("rk.inertial.integrate", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
     ),
     ("rk.inertial.preintegrate", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
@@ -385,6 +429,15 @@ FAILS = {
         "TracerArrayConversionError: The numpy.ndarray conversion method "
         "__array__() was called on traced array with shape float64[5,3] at "
         "applications/inertial/windows.py:split_windows"
+    ),
+    ("rk.inertial.states_from_trajectory", "grad"): (
+        "TracerArrayConversionError: The numpy.ndarray conversion method "
+        "__array__() was called on traced array with shape float64[3,6] at "
+        "applications/inertial/simulation.py:states_from_trajectory"
+    ),
+    ("rk.jacobians.plus", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
     ),
     ("rk.kinematics.angular_acceleration_from_euler_rates", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
@@ -414,7 +467,15 @@ FAILS = {
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
+    ("rk.kinematics.integrate_angular_velocity", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
     ("rk.kinematics.integrate_angular_velocity[rk4]", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.integrate_twist", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
@@ -478,11 +539,19 @@ FAILS = {
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
+    ("rk.kinematics.rotation_derivative", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
     ("rk.kinematics.rotation_second_derivative", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
     ("rk.kinematics.spatial_acceleration_matrix", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.transform_derivative", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
@@ -495,6 +564,10 @@ FAILS = {
         "array with shape bool[]. at _validate.py:check_finite"
     ),
     ("rk.kinematics.twist_from_screw", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.kinematics.twist_to_body", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
@@ -514,6 +587,10 @@ FAILS = {
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
+    ("rk.se3.pose_distance_unchecked", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
     ("rk.slerp", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
@@ -522,7 +599,14 @@ FAILS = {
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
+    ("rk.trajectory.align", "grad"): (
+        "AttributeError: 'tuple' object has no attribute 'as_matrix'"
+    ),
     ("rk.trajectory.ape", "grad"): (
+        "TracerBoolConversionError: Attempted boolean conversion of traced "
+        "array with shape bool[]. at _validate.py:check_finite"
+    ),
+    ("rk.trajectory.associate", "grad"): (
         "TracerBoolConversionError: Attempted boolean conversion of traced "
         "array with shape bool[]. at _validate.py:check_finite"
     ),
