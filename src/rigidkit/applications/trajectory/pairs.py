@@ -50,7 +50,7 @@ def _walk(cumulative, delta):
 
 
 def pair_indices(poses, delta, unit="frames", all_pairs=False, tolerance=0.1):
-    """The index pairs ``(i, j)`` that :func:`rigidkit.trajectory.rpe` compares, shape (M, 2).
+    """The ``(M, 2)`` index pairs ``(i, j)`` that :func:`rigidkit.trajectory.rpe` compares.
 
     Chosen on ``poses`` (a Transform of shape (N,)) as evo chooses them:
 
