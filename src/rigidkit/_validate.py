@@ -385,7 +385,11 @@ def check_finite(x, trail: tuple, what: str) -> None:
     else:
         xp = namespace_of(x)
         fin = xp.isfinite(x)
-        if bool(xp.all(fin)):
+        ok = xp.all(fin)
+        # A concrete input inside a trace (a constant closed over by jax.jit or
+        # jax.grad) gives a traced test: its value cannot be read, so it is skipped
+        # like a traced input's.
+        if not concrete(ok) or bool(ok):
             return
         bad = ~to_numpy(fin)
     if trail:
