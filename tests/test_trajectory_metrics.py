@@ -511,3 +511,35 @@ def test_position_distances_in_blocks_equal_the_norm(n):
     batch = metrics._distance(np.stack([a[:, :3], b[:, :3]]), b[:, :3])
     np.testing.assert_allclose(batch[0], expected, rtol=1e-15)
     np.testing.assert_array_equal(batch[1], 0.0)
+
+
+def test_statistics_of_torch_and_jax_errors_are_differentiable():
+    """``rk.trajectory.statistics`` of a torch or JAX series: the same numbers as the
+    NumPy path, in that namespace, with gradients equal to central differences."""
+    torch = pytest.importorskip("torch")
+    jax = pytest.importorskip("jax")
+    rng = np.random.default_rng(7)
+    e = rng.uniform(0.1, 2.0, size=7)
+    ref = rk.trajectory.statistics(e)
+    t = torch.tensor(e, requires_grad=True)
+    got = rk.trajectory.statistics(t)
+    for key, value in ref.items():
+        assert torch.is_tensor(got[key])
+        assert abs(float(got[key]) - value) <= 1e-12 * max(1.0, abs(value))
+    h = 1e-6
+    for key in ("rmse", "mean", "median", "std", "min", "max", "sse"):
+        (g,) = torch.autograd.grad(rk.trajectory.statistics(t)[key], t)
+        fd = np.empty_like(e)
+        for i in range(e.size):
+            up, down = e.copy(), e.copy()
+            up[i] += h
+            down[i] -= h
+            fd[i] = (
+                rk.trajectory.statistics(up)[key] - rk.trajectory.statistics(down)[key]
+            ) / (2 * h)
+        np.testing.assert_allclose(g.numpy(), fd, atol=1e-6)
+    x = jax.numpy.asarray(e)  # float64 with jax_enable_x64, else float32
+    gj = jax.jit(jax.grad(lambda x: rk.trajectory.statistics(x)["rmse"]))(x)
+    (gt,) = torch.autograd.grad(rk.trajectory.statistics(t)["rmse"], t)
+    rtol = 1e-12 if x.dtype == jax.numpy.float64 else 1e-6
+    np.testing.assert_allclose(np.asarray(gj), gt.numpy(), rtol=rtol)

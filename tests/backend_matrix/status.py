@@ -82,11 +82,6 @@ FAILS = {
     ("rk.trajectory.align", "jit"): (
         "AttributeError: 'tuple' object has no attribute 'as_matrix'"
     ),
-    ("rk.trajectory.statistics", "jit"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[6] at "
-        "applications/trajectory/metrics.py:statistics"
-    ),
     ("rk.FrameGraph.__init__", "vmap"): (
         "TracerArrayConversionError: The numpy.ndarray conversion method "
         "__array__() was called on traced array with shape float64[7] at "
@@ -150,11 +145,6 @@ FAILS = {
     ("rk.trajectory.align", "vmap"): (
         "AttributeError: 'tuple' object has no attribute 'as_matrix'"
     ),
-    ("rk.trajectory.statistics", "vmap"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[6] at "
-        "applications/trajectory/metrics.py:statistics"
-    ),
     ("rk.FrameGraph.__init__", "grad"): (
         "TracerArrayConversionError: The numpy.ndarray conversion method "
         "__array__() was called on traced array with shape float64[7] at "
@@ -217,11 +207,6 @@ FAILS = {
     ),
     ("rk.trajectory.align", "grad"): (
         "AttributeError: 'tuple' object has no attribute 'as_matrix'"
-    ),
-    ("rk.trajectory.statistics", "grad"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[6] at "
-        "applications/trajectory/metrics.py:statistics"
     ),
     ("rk.Affine.__getitem__", "torch_grad"): (
         "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
@@ -384,11 +369,6 @@ FAILS = {
     ("rk.trajectory.align", "torch_grad"): (
         "AttributeError: 'tuple' object has no attribute 'as_matrix'"
     ),
-    ("rk.trajectory.statistics", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead. at "
-        "applications/trajectory/metrics.py:statistics"
-    ),
     ("rk.Affine.__getitem__", "torch_vmap"): (
         "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
     ),
@@ -523,10 +503,6 @@ FAILS = {
     ),
     ("rk.trajectory.align", "torch_vmap"): (
         "AttributeError: 'tuple' object has no attribute 'as_matrix'"
-    ),
-    ("rk.trajectory.statistics", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
-        "storage at applications/trajectory/metrics.py:statistics"
     ),
     ("rk.Affine.__getitem__", "dask"): (
         "AssertionError: the call computed the graph 2 time(s)"

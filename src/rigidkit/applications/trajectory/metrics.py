@@ -50,9 +50,18 @@ def statistics(errors) -> dict:
     ``std`` is the population standard deviation (``ddof=0``), ``sse`` the sum of
     squares, as evo reports them.
 
+    A torch or JAX array gives arrays of its namespace instead (0-d for one
+    series), differentiable, as ``ape`` and ``rpe`` report them on such poses.
+
     >>> bool(statistics(np.array([3.0, 4.0]))["rmse"] == np.sqrt(12.5))
     True
     """
+    if (
+        not isinstance(errors, (np.ndarray, np.generic))
+        and hasattr(errors, "shape")
+        and not dask_backend.is_dask(errors)
+    ):
+        return _array_metrics.statistics(namespace_of(errors), errors)
     e = np.asarray(errors, dtype=np.float64)
     n = e.shape[-1]
     if n == 0:
