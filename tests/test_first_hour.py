@@ -251,3 +251,16 @@ def test_a_long_batch_repr_shows_a_few_rows_as_numpy_does():
     assert "..." in text and len(text.splitlines()) == 8  # 3 first, ..., 3 last
     first = ", ".join(f"{v:.6f}" for v in R[0].as_quat())
     assert first.split(", ")[0].lstrip("-") in text.splitlines()[1]
+
+
+def test_every_stored_kind_names_its_components_in_its_repr():
+    """A batch's repr labels its values with the stored components, never the
+    generic "values" (Rotation2D showed "values=" before)."""
+    for X in (
+        rk.Rotation2D.from_angle([0.1, 0.2]),
+        rk.Transform2D.identity(2),
+        rk.Rotation.identity(2),
+        rk.Transform.identity(2),
+    ):
+        head = repr(X).split("=\n", 1)[0]
+        assert "values" not in head and head.endswith(")"), head

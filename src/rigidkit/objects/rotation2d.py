@@ -54,6 +54,7 @@ class Rotation2D(BatchedArray, LieGroup, family="plane", rank=0):
 
     __slots__ = ("_data",)
     _trail = (2,)
+    _repr_columns = "(cos, sin)"
     _identity = (1.0, 0.0)  # (cos 0, sin 0)
     _compose_kernel = _k.complex_multiply
     _inverse_kernel = _k.complex_conjugate
