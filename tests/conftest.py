@@ -73,34 +73,6 @@ def pytest_runtest_setup(item):
     for mark in item.iter_markers("needs"):
         for name in mark.args:
             pytest.importorskip(OPTIONAL.get(name, name))
-    if _records_warnings(getattr(item, "function", None)):
-        settle_compiles()
-
-
-def settle_compiles():
-    """Wait for the numba loops requested so far (rigidkit's background thread).
-
-    numba's compiler enters ``warnings.catch_warnings()`` on that thread, and before
-    Python 3.14 the warnings state is one per process, not per thread: leaving the
-    block there restores filters and ``showwarning`` under a recorder opened on the
-    test's thread, so a warning raised meanwhile can be lost (``pytest.warns``:
-    "DID NOT WARN", seen once in a few CI runs). Tests that record warnings run
-    with no compile in flight; a test whose own calls start compiles calls this
-    again after a first, unrecorded call.
-    """
-    from rigidkit._engine import numba_backend
-
-    numba_backend.drain(timeout=120)
-
-
-def _records_warnings(fn) -> bool:
-    import inspect
-
-    try:
-        src = inspect.getsource(fn)
-    except (OSError, TypeError):
-        return False
-    return "pytest.warns" in src or "record=True" in src
 
 
 def _backend_fixture(name: str):
