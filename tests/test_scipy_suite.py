@@ -25,6 +25,17 @@ import numpy as np
 import pytest
 
 sst = pytest.importorskip("scipy.spatial.transform")
+import scipy  # noqa: E402
+
+# scipy 1.18's test modules key their array-API marks by scipy's own classes
+# (make_xp_pytest_marks: KeyError on a substituted class at import); the harness
+# is written for scipy 1.17's suite, which CI's Python 3.11 job installs.
+if tuple(int(p) for p in scipy.__version__.split(".")[:2]) >= (1, 18):
+    pytest.skip(
+        f"scipy {scipy.__version__}'s suite keys its marks by scipy's classes; "
+        "the substitution harness covers scipy 1.17",
+        allow_module_level=True,
+    )
 TESTS = Path(sst.__file__).parent / "tests"
 FILES = {
     "rotation": "test_rotation.py",
