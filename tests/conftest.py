@@ -14,6 +14,15 @@ alone when it is missing; every other test of the file still runs. Three spellin
   module or ``None``, for helpers and parametrisations that mention it.
 
 ``pytest.importorskip`` at module level is not used: it skips every test of the file.
+
+Compiled loops: the suite runs with ``RIGIDKIT_BACKGROUND_COMPILE=0`` (set here
+unless the environment says otherwise), so a batch whose loop is not ready is
+served by the Python-float and element-wise NumPy bindings, and no loop is compiled
+speculatively for each broadcast pattern and dtype a test happens to meet (on a
+cold cache, hundreds of 1-3 s compiles per test process: most of CI's time). Every
+kernel's compiled loop is still checked against the other bindings
+(tests/test_engine.py, ``backend="numba"``); tests of the background loader itself
+ask for it with the ``background_compiles`` fixture.
 """
 
 from __future__ import annotations
@@ -26,7 +35,10 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, settings
 
-from rigidkit.objects import registry
+# Before rigidkit is imported (read once, at import): see the module docstring.
+os.environ.setdefault("RIGIDKIT_BACKGROUND_COMPILE", "0")
+
+from rigidkit.objects import registry  # noqa: E402
 
 # torch's setup (bindings, adapter, pytree nodes) once per test process, where torch
 # is installed: as the doctest collection of rigidkit._engine.torch_setup did before
@@ -92,6 +104,15 @@ torch = _backend_fixture("torch")
 jax = _backend_fixture("jax")
 jnp = _backend_fixture("jnp")
 dask_array = _backend_fixture("dask_array")
+
+
+@pytest.fixture
+def background_compiles(monkeypatch):
+    """The engine as users get it: loops not ready are compiled in the background
+    (the suite runs without, see the module docstring)."""
+    from rigidkit._engine import kernel
+
+    monkeypatch.setattr(kernel, "BACKGROUND", True)
 
 
 @pytest.fixture

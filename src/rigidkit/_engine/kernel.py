@@ -65,6 +65,17 @@ NUMBA_MIN = (
 #: Tests set it to check one binding; the fast path steps aside when it is set.
 BINDING = None
 
+#: Whether a NumPy call whose compiled loop is not ready asks the background thread
+#: for it, to use from the next call on (True, the default). False
+#: (``RIGIDKIT_BACKGROUND_COMPILE=0``): a loop is compiled only where a caller waits
+#: for it (``backend="numba"``, ``RIGIDKIT_NUMBA_MIN``, ``rigidkit precompile``),
+#: and every other batch is served by the Python-float and element-wise NumPy
+#: bindings. For processes that call many kernels a few times each, where each
+#: speculative compile (1-3 s of CPU) costs more than it saves: the test suite,
+#: which checks each kernel's compiled loop once (tests/test_engine.py) instead of
+#: every broadcast pattern and dtype that other tests happen to meet.
+BACKGROUND = os.environ.get("RIGIDKIT_BACKGROUND_COMPILE", "1") != "0"
+
 #: A kernel called this many times on one element asks for a compiled one-element
 #: loop (faster than Python floats there, mostly by not packing a new array).
 SINGLE_HOT = 64
@@ -163,7 +174,7 @@ class Kernel(_Rebindable):
             self._nsingle[key] = n + 1
         elif n == SINGLE_HOT:
             self._nsingle[key] = n + 1
-            if numba_backend.available():
+            if BACKGROUND and numba_backend.available():
                 dtype, ints = key if self.params else (key, ())
                 numba_backend.request(self, numba_backend.SINGLE, dtype, ints)
 
@@ -263,7 +274,7 @@ class Kernel(_Rebindable):
             else:
                 # Not ready: ask the background thread for the loop and serve this
                 # batch without it (never wait for numba's import or a compile).
-                if numba_backend.available():
+                if BACKGROUND and numba_backend.available():
                     numba_backend.request(self, bcast, dtype, ints)
                 if n <= ROWS_MAX:
                     res = self._call_rows(params, arrays, batch, dtype, n)
@@ -368,7 +379,8 @@ class Kernel(_Rebindable):
             threaded = self._threaded.get(bcast, {}).get(key)
             if threaded is None:
                 # Asked for now, for the next batch; this one runs on one thread.
-                numba_backend.request(self, bcast, dtype, ints, nogil=True)
+                if BACKGROUND:
+                    numba_backend.request(self, bcast, dtype, ints, nogil=True)
                 workers = 1
             else:
                 loop = threaded
