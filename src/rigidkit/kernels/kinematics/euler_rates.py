@@ -193,6 +193,23 @@ def permuted_to_world_3(e1, e2, p0, p1, p2):
 
 
 @helper
+def permuted_from_world_3(e1, e2, x, y, z):
+    """Components on axes ``(e1, e2, m)`` of a vector given on ``(x, y, z)``."""
+    w = (x, y, z)
+    return (w[e1], w[e2], w[3 - e1 - e2])
+
+
+@helper
+def columns_times(c, u1, u2, u3):
+    """``c[0:3] u1 + c[3:6] u2 + c[6:9] u3``: the matrix of columns ``c`` times ``u``."""
+    return (
+        c[0] * u1 + c[3] * u2 + c[6] * u3,
+        c[1] * u1 + c[4] * u2 + c[7] * u3,
+        c[2] * u1 + c[5] * u2 + c[8] * u3,
+    )
+
+
+@helper
 def triples_in_sequence_order(e1, e2, reverse, v):
     """``v[0:3], v[3:6], v[6:9]`` (product order, permuted coordinates) in sequence order.
 
@@ -231,18 +248,27 @@ def dot3(ax, ay, az, bx, by, bz):
 
 
 @helper
+def rows_times_in_sequence_order(reverse, scale, r, p0, p1, p2):
+    """``(r[0:3] . p, r[3:6] . p, r[6:9] . p) / scale`` in sequence order.
+
+    ``r`` holds three rows in product order, ``p`` is in permuted coordinates.
+    """
+    inv = 1.0 / scale
+    u1 = inv * dot3(r[0], r[1], r[2], p0, p1, p2)
+    u2 = inv * dot3(r[3], r[4], r[5], p0, p1, p2)
+    u3 = inv * dot3(r[6], r[7], r[8], p0, p1, p2)
+    return euler_product_order(reverse, u1, u2, u3)
+
+
+@helper
 def rates_from_inverse_rows(reverse, scale, r, p0, p1, p2):
     """``E^-1 p`` in sequence order, and :func:`lock_sine`.
 
     ``r`` from :func:`euler_rate_inverse_rows`, ``p`` in permuted coordinates;
     divided by ``scale`` (rates in the angles' unit).
     """
-    inv = 1.0 / scale
-    u1 = inv * dot3(r[0], r[1], r[2], p0, p1, p2)
-    u2 = inv * dot3(r[3], r[4], r[5], p0, p1, p2)
-    u3 = inv * dot3(r[6], r[7], r[8], p0, p1, p2)
-    rev = reverse == 1
-    return (where(rev, u3, u1), u2, where(rev, u1, u3), lock_sine(r[9]))
+    rates = rows_times_in_sequence_order(reverse, scale, r, p0, p1, p2)
+    return rates + (lock_sine(r[9]),)
 
 
 _PARAMS = ("e1", "e2", "parity", "proper", "reverse", "body", "scale")
@@ -302,9 +328,7 @@ def omega_from_euler_rates(
     t1, t2, t3 = euler_product_order(reverse, a0 * scale, a1 * scale, a2 * scale)
     u1, u2, u3 = euler_product_order(reverse, r0 * scale, r1 * scale, r2 * scale)
     c = euler_rate_columns(parity, proper, body, t1, t2, t3)
-    p0 = c[0] * u1 + c[3] * u2 + c[6] * u3
-    p1 = c[1] * u1 + c[4] * u2 + c[7] * u3
-    p2 = c[2] * u1 + c[5] * u2 + c[8] * u3
+    p0, p1, p2 = columns_times(c, u1, u2, u3)
     return permuted_to_world_3(e1, e2, p0, p1, p2)
 
 
@@ -315,11 +339,7 @@ def euler_rates_from_omega(
     """``rates = E^-1 @ omega`` (sequence order) and :func:`lock_sine`."""
     t1, t2, t3 = euler_product_order(reverse, a0 * scale, a1 * scale, a2 * scale)
     r = euler_rate_inverse_rows(parity, proper, body, t1, t2, t3)
-    w = (wx, wy, wz)
-    m = 3 - e1 - e2
-    p0 = w[e1]
-    p1 = w[e2]
-    p2 = w[m]
+    p0, p1, p2 = permuted_from_world_3(e1, e2, wx, wy, wz)
     return rates_from_inverse_rows(reverse, scale, r, p0, p1, p2)
 
 
@@ -348,12 +368,9 @@ def euler_accelerations_from_alpha(
     u1, u2, u3 = euler_product_order(reverse, r0 * scale, r1 * scale, r2 * scale)
     dc = euler_rate_column_derivatives(parity, proper, body, t1, t2, t3, u1, u2, u3)
     r = euler_rate_inverse_rows(parity, proper, body, t1, t2, t3)
-    al = (ax, ay, az)
-    m = 3 - e1 - e2
-    p0 = al[e1] - (dc[0] * u1 + dc[3] * u2 + dc[6] * u3)
-    p1 = al[e2] - (dc[1] * u1 + dc[4] * u2 + dc[7] * u3)
-    p2 = al[m] - (dc[2] * u1 + dc[5] * u2 + dc[8] * u3)
-    return rates_from_inverse_rows(reverse, scale, r, p0, p1, p2)
+    l0, l1, l2 = permuted_from_world_3(e1, e2, ax, ay, az)
+    q0, q1, q2 = columns_times(dc, u1, u2, u3)
+    return rates_from_inverse_rows(reverse, scale, r, l0 - q0, l1 - q1, l2 - q2)
 
 
 @kernel(inputs=[(3,), (3,)], outputs=[(3,)], params=_PARAMS)
@@ -373,17 +390,9 @@ def euler_rates_projected(
     """
     t1, t2, t3 = euler_product_order(reverse, a0 * scale, a1 * scale, a2 * scale)
     c = euler_rate_columns(parity, proper, body, t1, t2, t3)
-    w = (wx, wy, wz)
-    m = 3 - e1 - e2
-    p0 = w[e1]
-    p1 = w[e2]
-    p2 = w[m]
-    inv = 1.0 / scale  # E^T / scale^2 = Q^T / scale, Q the unit columns
-    u1 = inv * dot3(c[0], c[1], c[2], p0, p1, p2)
-    u2 = inv * dot3(c[3], c[4], c[5], p0, p1, p2)
-    u3 = inv * dot3(c[6], c[7], c[8], p0, p1, p2)
-    rev = reverse == 1
-    return (where(rev, u3, u1), u2, where(rev, u1, u3))
+    p0, p1, p2 = permuted_from_world_3(e1, e2, wx, wy, wz)
+    # E^T / scale^2 = Q^T / scale, Q the unit columns
+    return rows_times_in_sequence_order(reverse, scale, c, p0, p1, p2)
 
 
 @kernel(inputs=[(3,)], outputs=[(3, 3)], params=_PARAMS)
