@@ -50,7 +50,7 @@ __all__ = [
 
 # Rows and columns 3 and 4 swapped: its bottom row is the 4th row of the matrix,
 # ``[0, 0, 0, 1, 0]`` read as ``[0, 0, 0, 0, 1]`` (one check for both rows).
-_SWAP = (0, 1, 2, 4, 3)
+_SWAP = [0, 1, 2, 4, 3]
 
 
 def _tangent(xi):
