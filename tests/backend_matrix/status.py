@@ -54,16 +54,6 @@ FAILS = {
         "concrete value is expected: traced array with shape float64[] at "
         "functional/splines.py:rotation_spline_coefficients"
     ),
-    ("rk.Trajectory.duration", "jit"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[6] at "
-        "applications/trajectory/trajectory.py:check_stamps"
-    ),
-    ("rk.Trajectory.stamps", "jit"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[6] at "
-        "applications/trajectory/trajectory.py:check_stamps"
-    ),
     ("rk.inertial.imu_from_trajectory", "jit"): (
         "TracerArrayConversionError: The numpy.ndarray conversion method "
         "__array__() was called on traced array with shape float64[3,6] at "
@@ -78,9 +68,6 @@ FAILS = {
         "TracerArrayConversionError: The numpy.ndarray conversion method "
         "__array__() was called on traced array with shape float64[3,6] at "
         "applications/inertial/simulation.py:states_from_trajectory"
-    ),
-    ("rk.trajectory.align", "jit"): (
-        "AttributeError: 'tuple' object has no attribute 'as_matrix'"
     ),
     ("rk.FrameGraph.__init__", "vmap"): (
         "TracerArrayConversionError: The numpy.ndarray conversion method "
@@ -117,16 +104,6 @@ FAILS = {
         "concrete value is expected: traced array with shape float64[] at "
         "functional/splines.py:rotation_spline_coefficients"
     ),
-    ("rk.Trajectory.duration", "vmap"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[6] at "
-        "applications/trajectory/trajectory.py:check_stamps"
-    ),
-    ("rk.Trajectory.stamps", "vmap"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[6] at "
-        "applications/trajectory/trajectory.py:check_stamps"
-    ),
     ("rk.inertial.imu_from_trajectory", "vmap"): (
         "TracerArrayConversionError: The numpy.ndarray conversion method "
         "__array__() was called on traced array with shape float64[3,6] at "
@@ -141,9 +118,6 @@ FAILS = {
         "TracerArrayConversionError: The numpy.ndarray conversion method "
         "__array__() was called on traced array with shape float64[3,6] at "
         "applications/inertial/simulation.py:states_from_trajectory"
-    ),
-    ("rk.trajectory.align", "vmap"): (
-        "AttributeError: 'tuple' object has no attribute 'as_matrix'"
     ),
     ("rk.FrameGraph.__init__", "grad"): (
         "TracerArrayConversionError: The numpy.ndarray conversion method "
@@ -180,16 +154,6 @@ FAILS = {
         "concrete value is expected: traced array with shape float64[] at "
         "functional/splines.py:rotation_spline_coefficients"
     ),
-    ("rk.Trajectory.duration", "grad"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[6] at "
-        "applications/trajectory/trajectory.py:check_stamps"
-    ),
-    ("rk.Trajectory.stamps", "grad"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[6] at "
-        "applications/trajectory/trajectory.py:check_stamps"
-    ),
     ("rk.inertial.imu_from_trajectory", "grad"): (
         "TracerArrayConversionError: The numpy.ndarray conversion method "
         "__array__() was called on traced array with shape float64[3,6] at "
@@ -204,9 +168,6 @@ FAILS = {
         "TracerArrayConversionError: The numpy.ndarray conversion method "
         "__array__() was called on traced array with shape float64[3,6] at "
         "applications/inertial/simulation.py:states_from_trajectory"
-    ),
-    ("rk.trajectory.align", "grad"): (
-        "AttributeError: 'tuple' object has no attribute 'as_matrix'"
     ),
     ("rk.Affine.__getitem__", "torch_grad"): (
         "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
@@ -341,16 +302,6 @@ FAILS = {
         "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
         "tensor.detach().numpy() instead."
     ),
-    ("rk.Trajectory.duration", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead. at "
-        "applications/trajectory/trajectory.py:check_stamps"
-    ),
-    ("rk.Trajectory.stamps", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead. at "
-        "applications/trajectory/trajectory.py:check_stamps"
-    ),
     ("rk.inertial.imu_from_trajectory", "torch_grad"): (
         "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
         "tensor.detach().numpy() instead. at "
@@ -365,9 +316,6 @@ FAILS = {
         "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
         "tensor.detach().numpy() instead. at "
         "applications/inertial/simulation.py:states_from_trajectory"
-    ),
-    ("rk.trajectory.align", "torch_grad"): (
-        "AttributeError: 'tuple' object has no attribute 'as_matrix'"
     ),
     ("rk.Affine.__getitem__", "torch_vmap"): (
         "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
@@ -481,14 +429,6 @@ FAILS = {
         "We don't support vmap over calling .item() on a Tensor, please try to "
         "rewrite what y at functional/splines.py:rotation_spline_coefficients"
     ),
-    ("rk.Trajectory.duration", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
-        "storage at applications/trajectory/trajectory.py:check_stamps"
-    ),
-    ("rk.Trajectory.stamps", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
-        "storage at applications/trajectory/trajectory.py:check_stamps"
-    ),
     ("rk.inertial.imu_from_trajectory", "torch_vmap"): (
         "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
         "storage at applications/inertial/simulation.py:_pose_and_twists"
@@ -500,9 +440,6 @@ FAILS = {
     ("rk.inertial.states_from_trajectory", "torch_vmap"): (
         "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
         "storage at applications/inertial/simulation.py:states_from_trajectory"
-    ),
-    ("rk.trajectory.align", "torch_vmap"): (
-        "AttributeError: 'tuple' object has no attribute 'as_matrix'"
     ),
     ("rk.Affine.__getitem__", "dask"): (
         "AssertionError: the call computed the graph 2 time(s)"
@@ -539,10 +476,6 @@ FAILS = {
     ),
     ("rk.Affine.translation", "dask"): (
         "AssertionError: the call computed the graph 2 time(s)"
-    ),
-    ("rk.ExtendedPose.from_matrix", "dask"): (
-        "TypeError: '>=' not supported between instances of 'tuple' and 'int' "
-        "at functional/se23.py:extpose_from_matrix"
     ),
     ("rk.FrameGraph.__init__", "dask"): (
         "ShapeError: a static edge takes one pose, got a batch of shape (2,); "
@@ -584,12 +517,6 @@ FAILS = {
     ),
     ("rk.Rotation2D.as_complex", "dask"): (
         "AssertionError: the call computed the graph 2 time(s)"
-    ),
-    ("rk.Trajectory.duration", "dask"): (
-        "AssertionError: the call computed the graph 1 time(s)"
-    ),
-    ("rk.Trajectory.stamps", "dask"): (
-        "AssertionError: the call computed the graph 1 time(s)"
     ),
     ("rk.conversions.nearest_rotation_matrix", "dask"): (
         "ValueError: Array must be 2D. at functional/conversions.py:nearest_rotation_matrix"
@@ -637,18 +564,6 @@ FAILS = {
     ("rk.kinematics.planar.integrate_twist", "dask"): (
         "AssertionError: the call computed the graph 1 time(s)"
     ),
-    ("rk.se23.adjoint", "dask"): (
-        "TypeError: '>=' not supported between instances of 'tuple' and 'int' "
-        "at functional/se23.py:extpose_from_matrix"
-    ),
-    ("rk.se23.extpose_from_matrix", "dask"): (
-        "TypeError: '>=' not supported between instances of 'tuple' and 'int' "
-        "at functional/se23.py:extpose_from_matrix"
-    ),
-    ("rk.se23.log", "dask"): (
-        "TypeError: '>=' not supported between instances of 'tuple' and 'int' "
-        "at functional/se23.py:extpose_from_matrix"
-    ),
     ("rk.sim3.left_jacobian_inverse", "dask"): (
         "ValueError: Dimension must be 2 to perform lu decomposition at "
         "functional/sim3.py:_left_jacobian_inverse"
@@ -656,9 +571,6 @@ FAILS = {
     ("rk.sim3.right_jacobian_inverse", "dask"): (
         "ValueError: Dimension must be 2 to perform lu decomposition at "
         "functional/sim3.py:_left_jacobian_inverse"
-    ),
-    ("rk.trajectory.align", "dask"): (
-        "AttributeError: 'tuple' object has no attribute 'as_matrix'"
     ),
     ("rk.trajectory.ape", "dask"): (
         "AssertionError: the call computed the graph 2 time(s)"
