@@ -304,3 +304,45 @@ def test_torch_autograd_through_at_matches_finite_differences(torch, method):
         np.testing.assert_allclose(grad, fd, rtol=1e-7, atol=1e-8)
     # The screw motion moves the positions with the rotations; "linear" does not.
     assert (np.abs(rv_t.grad.numpy()).max() > 0.1) == (method == "slerp")
+
+
+def test_torch_stamps_stay_on_the_graph_and_are_checked(torch):
+    """Stamps of torch are kept as torch (duration's gradient is d(t[-1] - t[0])/dt,
+    by hand: -1 at the first stamp, +1 at the last), their values checked while
+    concrete, and searched on the host (``at`` equals the NumPy stamps' result)."""
+    poses = rk.Transform.random(4, rng=2)
+    t = torch.tensor([0.0, 0.5, 1.25, 2.0], dtype=torch.float64, requires_grad=True)
+    traj = rk.Trajectory(t, poses)
+    assert traj.stamps is t
+    (grad,) = torch.autograd.grad(traj.duration, t)
+    np.testing.assert_array_equal(grad.numpy(), [-1.0, 0.0, 0.0, 1.0])
+    np.testing.assert_allclose(
+        traj.at([0.3, 1.9]).poses.as_pq(),
+        rk.Trajectory(t.detach().numpy(), poses).at([0.3, 1.9]).poses.as_pq(),
+        rtol=0,
+        atol=1e-15,
+    )
+    with pytest.raises(rk.TimestampError, match="goes backwards") as info:
+        rk.Trajectory(torch.tensor([0.0, 2.0, 1.0, 3.0]), poses)
+    assert info.value.index == (2,)
+    with pytest.raises(rk.ShapeError, match=r"shape \(4,\)"):
+        rk.Trajectory(torch.zeros(3), poses)
+    with rk.set_validation(False):  # the value checks are off; the shape's stays
+        rk.Trajectory(torch.tensor([0.0, 2.0, 1.0, 3.0]), poses)
+
+
+def test_dask_stamps_stay_lazy(dask_array):
+    da = dask_array
+    from dask.callbacks import Callback
+
+    computes = []
+
+    class Count(Callback):
+        def _start(self, dsk):
+            computes.append(1)
+
+    stamps = da.from_array(np.array([0.0, 0.5, 1.25, 2.0]), chunks=2)
+    with Count():
+        duration = rk.Trajectory(stamps, rk.Transform.identity(4)).duration
+    assert not computes and type(duration).__module__.startswith("dask")
+    assert float(duration.compute()) == 2.0

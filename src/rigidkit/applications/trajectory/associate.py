@@ -6,7 +6,7 @@ import numpy as np
 
 from ...errors import TimestampError
 from ._loops import nearest_loop
-from .trajectory import Trajectory
+from .trajectory import Trajectory, host_stamps
 
 __all__ = ["associate", "nearest_pairs"]
 
@@ -140,9 +140,9 @@ def associate(ref, est, max_diff=0.01, offset=0.0, method="nearest", max_gap=Non
             raise TypeError(f"{name} must be a Trajectory, got {type(traj).__name__}")
         if traj.stamps is None:
             raise TimestampError(f"{name} has no stamps to associate by")
-    t_ref = ref.stamps
+    t_ref, t_est = host_stamps(ref.stamps), host_stamps(est.stamps)
     # Without an offset, no copy of the stamps (8 MB for a million poses).
-    t_est = est.stamps + float(offset) if float(offset) != 0.0 else est.stamps
+    t_est = t_est + float(offset) if float(offset) != 0.0 else t_est
     if method == "nearest":
         i_ref, i_est, strict = _pairs(t_ref, t_est, float(max_diff))
         if len(i_ref):

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..._engine.namespace import is_torch, namespace_of
+from ..._validate import checks_now, concrete, to_numpy
 from ...errors import OutOfRangeError, ShapeError, TimestampError
 from ...objects._batch import expect
 from ...objects.similarity import Similarity
@@ -13,7 +14,7 @@ from ..interpolation import Slerp
 from ..kinematics import twist_from_samples
 from ..splines import BSplineSE3
 
-__all__ = ["Trajectory", "check_stamps", "check_pair"]
+__all__ = ["Trajectory", "check_stamps", "check_pair", "host_stamps"]
 
 
 def _moveaxis(x, source: int, destination: int):
@@ -27,21 +28,22 @@ def _moveaxis(x, source: int, destination: int):
     return namespace_of(x).permute_dims(x, tuple(perm))
 
 
-def check_stamps(stamps, n: int, what: str = "stamps") -> np.ndarray:
-    """``stamps`` as a read-only float64 array of shape ``(n,)``, validated.
+def _foreign(x) -> bool:
+    """Whether ``x`` is an array of another namespace (torch, JAX, Dask), kept in it."""
+    return (
+        hasattr(x, "shape")
+        and hasattr(x, "dtype")
+        and not isinstance(x, (np.ndarray, np.generic))
+    )
 
-    Raises :class:`~rigidkit.ShapeError` for a wrong shape and
-    :class:`~rigidkit.TimestampError` (with ``.index``, the first offending
-    position) for a non-finite stamp or one not after its predecessor.
-    """
-    t = np.array(stamps, dtype=np.float64)  # a copy: the caller keeps its array
-    if t.shape != (n,):
-        raise ShapeError(f"{what} must have shape ({n},) (one per pose), got {t.shape}")
+
+def _check_values(t, what):
+    """The value checks of :func:`check_stamps` on a NumPy array ``t``."""
     bad = ~np.isfinite(t)
     if bad.any():
         i = int(np.argmax(bad))
         raise TimestampError(f"{what}[{i}] is {float(t[i])!r}, not finite", index=(i,))
-    if n > 1:
+    if t.shape[0] > 1:
         step = np.diff(t)
         if not (step > 0.0).all():
             i = int(np.argmax(~(step > 0.0))) + 1
@@ -52,8 +54,44 @@ def check_stamps(stamps, n: int, what: str = "stamps") -> np.ndarray:
                 "stamps must be strictly increasing",
                 index=(i,),
             )
+
+
+def check_stamps(stamps, n: int, what: str = "stamps"):
+    """``stamps`` as an array of shape ``(n,)``, validated.
+
+    NumPy input (and lists) gives a read-only float64 copy. An array of another
+    namespace (torch, JAX, Dask) is kept in it, so that its stamps stay on the
+    caller's graph (autograd, tracing, lazy Dask); its values are checked only
+    where they can be read now (not under tracing, not on Dask, and never with
+    ``rk.set_validation(False)``).
+
+    Raises :class:`~rigidkit.ShapeError` for a wrong shape and
+    :class:`~rigidkit.TimestampError` (with ``.index``, the first offending
+    position) for a non-finite stamp or one not after its predecessor.
+    """
+    if _foreign(stamps):
+        shape = tuple(stamps.shape)
+        if shape != (n,):
+            raise ShapeError(f"{what} must have shape ({n},) (one per pose), got {shape}")
+        if "float" not in str(stamps.dtype):
+            stamps = stamps.double() if is_torch(stamps) else stamps.astype(np.float64)
+        if checks_now(stamps):
+            _check_values(np.asarray(to_numpy(stamps), dtype=np.float64), what)
+        return stamps
+    t = np.array(stamps, dtype=np.float64)  # a copy: the caller keeps its array
+    if t.shape != (n,):
+        raise ShapeError(f"{what} must have shape ({n},) (one per pose), got {t.shape}")
+    _check_values(t, what)
     t.flags.writeable = False
     return t
+
+
+def host_stamps(stamps):
+    """``stamps`` (NumPy, or concrete torch or JAX) as NumPy float64, for the
+    searches and sorts of the stamps, which run on the host."""
+    if stamps is None or isinstance(stamps, np.ndarray):
+        return stamps
+    return np.asarray(to_numpy(stamps), dtype=np.float64)
 
 
 class Trajectory:
@@ -171,7 +209,7 @@ class Trajectory:
     def __repr__(self):
         span = (
             ""
-            if self._stamps is None or not len(self)
+            if self._stamps is None or not len(self) or not concrete(self._stamps)
             else f", t in [{float(self._stamps[0])!r}, {float(self._stamps[-1])!r}]"
         )
         return f"Trajectory({len(self)} poses{span}, shape={self.shape})"
@@ -199,14 +237,22 @@ class Trajectory:
 
     @property
     def duration(self) -> float:
-        """``stamps[-1] - stamps[0]`` in seconds (0 for fewer than two poses)."""
+        """``stamps[-1] - stamps[0]`` in seconds (0 for fewer than two poses).
+
+        A float for NumPy stamps; a 0-d array of the stamps' namespace for torch,
+        JAX or Dask stamps (differentiable, lazy on Dask).
+        """
         if self._stamps is None:
             raise TimestampError("this trajectory has no stamps, so no duration")
-        return float(self._stamps[-1] - self._stamps[0]) if len(self) > 1 else 0.0
+        t = self._stamps
+        if not isinstance(t, np.ndarray):  # torch, JAX, Dask: in their namespace
+            return t[-1] - t[0] if len(self) > 1 else t[:1].sum() * 0.0
+        return float(t[-1] - t[0]) if len(self) > 1 else 0.0
 
     def _times(self):
+        """The stamps on the host (NumPy), the index where there are none."""
         if self._stamps is not None:
-            return self._stamps
+            return host_stamps(self._stamps)
         return np.arange(len(self), dtype=np.float64)
 
     # -- operations --------------------------------------------------------------------
@@ -241,7 +287,8 @@ class Trajectory:
             A time outside the stamps' range (the message names the range).
         """
         t = self._times()
-        q = check_stamps(times, np.shape(times)[0] if np.ndim(times) else -1, "times")
+        n = np.shape(times)[0] if np.ndim(times) else -1
+        q = host_stamps(check_stamps(times, n, "times"))
         if len(t) < 2:
             raise OutOfRangeError(f"interpolation needs at least 2 poses, got {len(t)}")
         if len(q) and (q[0] < t[0] or q[-1] > t[-1]):
