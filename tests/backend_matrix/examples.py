@@ -952,7 +952,11 @@ for _m in ("shape", "__len__", "__iter__"):
 _t = "rk.trajectory."
 ex(
     _t + "align",
-    lambda x, y: rk.trajectory.align(_traj(x), _traj(y)).as_matrix(),
+    # (aligned_est, ref_S_est): the aligned poses and the fitted transform
+    lambda x, y: [
+        r.as_matrix() if isinstance(r, rk.Transform) else r.poses.as_matrix()
+        for r in rk.trajectory.align(_traj(x), _traj(y))
+    ],
     _TX,
     _TX,
     series=True,
