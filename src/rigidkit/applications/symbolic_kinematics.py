@@ -188,26 +188,35 @@ def euler_rate_matrix(seq, symbols=None, *, frame):
     [0,  cos(phi), sin(phi)*cos(theta)],
     [0, -sin(phi), cos(phi)*cos(theta)]])
     """
-    body = body_flag(frame, "symbolic.euler_rate_matrix")
-    s, n, angles, padded = _rate_setup(seq, symbols)
-    fn = _ke.rate_matrix_from_euler.bound(_generic_bindings(angles))
-    e = fn(*s.params, body, sp.Integer(1), *padded)
+    n, e = _rate_entries(seq, symbols, frame, inverse=False)
     E = sp.Matrix(3, 3, [sp.expand(_exact(sp.sympify(x))) for x in e])
     return E[:, :n]
 
 
-def _rate_setup(seq, symbols):
-    """The parsed (padded) sequence, ``n``, its ``n`` symbols and the three angles.
+def _rate_entries(seq, symbols, frame, *, inverse):
+    """``n`` and the 9 row-major entries of ``E`` (or of ``E^-1``) over symbols.
 
-    One or two axes (``"ZX"``) are padded with turns by 0, as ``from_euler`` pads
-    them (:func:`~rigidkit.functional.euler.parse_short_sequence`).
+    The kernel ``rate_matrix_from_euler``; with ``inverse``,
+    ``rate_matrix_inverse_from_euler``, or ``rate_matrix_transpose_from_euler``
+    for one or two axes (``"ZX"``), which are padded with turns by 0, as
+    ``from_euler`` pads them (:func:`~rigidkit.functional.euler.parse_short_sequence`).
     """
+    name = "euler_rate_matrix_inverse" if inverse else "euler_rate_matrix"
+    body = body_flag(frame, f"symbolic.{name}")
     if isinstance(seq, str) and len(seq) == 3:
         s, n = parse_sequence(seq), 3
     else:
         s, n = parse_short_sequence(seq)
     angles = _symbols(symbols, " ".join(("alpha", "beta", "gamma")[:n]) + ",", n)
-    return s, n, angles, tuple(angles) + (sp.Integer(0),) * (3 - n)
+    padded = tuple(angles) + (sp.Integer(0),) * (3 - n)
+    if not inverse:
+        k = _ke.rate_matrix_from_euler
+    elif n < 3:
+        k = _ke.rate_matrix_transpose_from_euler
+    else:
+        k = _ke.rate_matrix_inverse_from_euler
+    e = k.bound(_generic_bindings(angles))(*s.params, body, sp.Integer(1), *padded)
+    return n, e[:9]
 
 
 def euler_rate_matrix_inverse(seq, symbols=None, *, frame):
@@ -222,15 +231,13 @@ def euler_rate_matrix_inverse(seq, symbols=None, *, frame):
 
     Parameters
     ----------
-    seq : str
-    symbols : sequence of n SymPy expressions, optional
-        The angles in ``seq`` order (default real ``alpha, beta, gamma``).
-    frame : {"world", "body"}
+    seq, symbols, frame
+        As in :func:`euler_rate_matrix`.
 
     Examples
     --------
-    The body matrix of intrinsic ``"ZYX"`` (yaw ``psi``, pitch ``theta``, roll
-    ``phi``): the rows ``psi'`` (top) to ``phi'``, from ``omega_body``:
+    For intrinsic ``"ZYX"`` (yaw ``psi``, pitch ``theta``, roll ``phi``), in the
+    body frame: the rows ``psi'`` (top) to ``phi'``, from ``omega_body``:
 
     >>> import sympy as sp
     >>> phi, theta, psi = sp.symbols("phi theta psi", real=True)
@@ -240,15 +247,7 @@ def euler_rate_matrix_inverse(seq, symbols=None, *, frame):
     [0,            cos(phi),           -sin(phi)],
     [1, sin(phi)*tan(theta), cos(phi)*tan(theta)]])
     """
-    body = body_flag(frame, "symbolic.euler_rate_matrix_inverse")
-    s, n, angles, padded = _rate_setup(seq, symbols)
-    bindings = _generic_bindings(angles)
-    if n < 3:
-        fn = _ke.rate_matrix_transpose_from_euler.bound(bindings)
-        e = fn(*s.params, body, sp.Integer(1), *padded)
-    else:
-        fn = _ke.rate_matrix_inverse_from_euler.bound(bindings)
-        e = fn(*s.params, body, sp.Integer(1), *padded)[:9]
+    n, e = _rate_entries(seq, symbols, frame, inverse=True)
     E = sp.Matrix(3, 3, [sp.simplify(_exact(sp.sympify(x))) for x in e])
     return E[:n, :]
 
