@@ -241,6 +241,30 @@ def test_windows_of_a_long_log_in_one_call(rng):
     np.testing.assert_allclose(X.as_matrix(), Xw.as_matrix(), rtol=0, atol=1e-12)
 
 
+def test_split_windows_stamps_must_be_host_numbers(jax, rng):
+    """The stamps fix the windows' shape: traced stamps raise a DegenerateInputError
+    that says so; traced samples with host stamps are gathered (jit traces)."""
+    t = np.cumsum(rng.uniform(0.05, 0.15, 8))
+    w, f = log(rng, 8)
+    kf = np.array([t[0], t[3] + 0.01, t[7]])
+    want = rk.inertial.split_windows(t, w, f, kf)
+    got = jax.jit(lambda w, f: rk.inertial.split_windows(t, w, f, kf))(w, f)
+    for g, x in zip(got, want):
+        np.testing.assert_array_equal(np.asarray(g), x)
+    with pytest.raises(rk.errors.DegenerateInputError, match="times must be concrete"):
+        jax.jit(lambda t: rk.inertial.split_windows(t, w, f, kf))(t)
+
+
+def test_split_windows_keeps_float32(rng):
+    t = np.arange(6) * 0.1
+    w, f = log(rng, 6)
+    g, a, dt = rk.inertial.split_windows(
+        t, w.astype(np.float32), f.astype(np.float32), [0.0, 0.25, 0.5]
+    )
+    assert g.dtype == a.dtype == dt.dtype == np.float32
+    np.testing.assert_allclose(dt.sum(axis=-1), [0.25, 0.25], rtol=1e-6)
+
+
 def test_float32_and_batches(rng):
     w, f = log(rng, 16)
     pim = rk.inertial.preintegrate(

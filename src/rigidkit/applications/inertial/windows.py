@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._validate import finite_array
+from ..._engine.dask_backend import is_dask
+from ..._engine.namespace import device_of, is_torch, namespace_of
+from ..._validate import as_float, finite_array, to_numpy
 from ...errors import DegenerateInputError
 
 __all__ = ["split_windows"]
@@ -22,7 +24,8 @@ def split_windows(times, gyro, accel, keyframe_times):
     Parameters
     ----------
     times : array_like, shape (N,)
-        Increasing sample stamps (s).
+        Increasing sample stamps (s). They and ``keyframe_times`` decide the
+        windows' count and length, so they are read as host numbers (not traced).
     gyro, accel : array_like, shape (N, 3)
         Body rates (rad/s) and specific forces (m/s^2) in the body frame.
     keyframe_times : array_like, shape (K,)
@@ -30,8 +33,11 @@ def split_windows(times, gyro, accel, keyframe_times):
 
     Returns
     -------
-    gyro, accel : ndarray, shape (K - 1, M, 3)
-    dt : ndarray, shape (K - 1, M)
+    gyro, accel : array, shape (K - 1, M, 3)
+        Rows of ``gyro`` and ``accel``, in their namespace (JAX, torch with its
+        gradients, Dask lazily).
+    dt : array, shape (K - 1, M)
+        In the namespace, float dtype and device of ``gyro``.
 
     Examples
     --------
@@ -41,18 +47,23 @@ def split_windows(times, gyro, accel, keyframe_times):
     >>> g.shape, np.round(dt.sum(axis=-1), 12)
     ((2, 7, 3), array([0.25, 0.65]))
     """
-    t = np.asarray(finite_array(times, (), "times"), dtype=np.float64)
-    kf = np.asarray(finite_array(keyframe_times, (), "keyframe_times"), dtype=np.float64)
-    gyro = np.asarray(finite_array(gyro, (3,), "gyro"))
-    accel = np.asarray(finite_array(accel, (3,), "accel"))
-    if t.ndim != 1 or len(t) != len(gyro) or len(t) != len(accel):
+    t = _host(finite_array(times, (), "times"), "times")
+    kf = _host(finite_array(keyframe_times, (), "keyframe_times"), "keyframe_times")
+    gyro = as_float(finite_array(gyro, (3,), "gyro"))
+    accel = as_float(finite_array(accel, (3,), "accel"))
+    if t.ndim != 1 or len(t) != gyro.shape[0] or len(t) != accel.shape[0]:
         raise DegenerateInputError("times, gyro and accel must have one row per sample")
+    if gyro.ndim != 2 or accel.ndim != 2:
+        raise DegenerateInputError("gyro and accel must have shape (N, 3)")
     if len(kf) < 2 or np.any(np.diff(kf) <= 0) or np.any(np.diff(t) <= 0):
         raise DegenerateInputError(
             "times and keyframe_times must increase (2 keyframes or more)"
         )
     if kf[0] < t[0]:
         raise DegenerateInputError(f"keyframe {kf[0]} is before the first sample {t[0]}")
+    # The windows' indices and durations come from the stamps alone (host numbers);
+    # the samples are only gathered, so gyro and accel keep their namespace (traced,
+    # differentiated, lazy).
     ends = np.append(t[1:], max(kf[-1], t[-1]))
     first = np.searchsorted(t, kf[:-1], side="right") - 1
     last = np.searchsorted(t, kf[1:], side="left") - 1
@@ -61,4 +72,39 @@ def split_windows(times, gyro, accel, keyframe_times):
     lo = np.maximum(t[idx], kf[:-1, None])
     hi = np.minimum(ends[idx], kf[1:, None])
     dt = np.where(first[:, None] + np.arange(m)[None, :] <= last[:, None], hi - lo, 0.0)
-    return gyro[idx], accel[idx], np.maximum(dt, 0.0)
+    dt = np.maximum(dt, 0.0)
+    return _gather(gyro, idx), _gather(accel, idx), _like(dt, gyro)
+
+
+def _host(x, what):
+    """Stamps as float64 NumPy: they fix the windows' count and length (the output's
+    shape), so they are read on the host; traced stamps cannot be."""
+    if type(x) is np.ndarray:
+        return x.astype(np.float64, copy=False)
+    try:
+        return np.asarray(to_numpy(x), dtype=np.float64)
+    except Exception as err:  # a JAX tracer, say: the windows' shape needs the values
+        raise DegenerateInputError(
+            f"split_windows: {what} must be concrete (host) numbers: they decide the "
+            "windows' shape, which a traced array cannot"
+        ) from err
+
+
+def _gather(x, idx):
+    """``x[idx]`` (rows of ``x`` (N, 3) at ``idx`` (K, M)) in ``x``'s namespace."""
+    flat = idx.reshape(-1)
+    if is_torch(x):
+        flat = namespace_of(x).asarray(flat, device=device_of(x))
+    return x[flat].reshape(idx.shape + (3,))
+
+
+def _like(a, like):
+    """The NumPy array ``a`` in the namespace, float dtype and device of ``like``."""
+    if type(like) is np.ndarray:
+        return a.astype(like.dtype, copy=False)
+    if is_dask(like):
+        import dask.array as da
+
+        return da.from_array(a.astype(like.dtype, copy=False))
+    xp = namespace_of(like)
+    return xp.asarray(a, dtype=like.dtype, device=device_of(like))
