@@ -59,11 +59,6 @@ FAILS = {
         "__array__() was called on traced array with shape float64[3,6] at "
         "applications/inertial/simulation.py:_pose_and_twists"
     ),
-    ("rk.inertial.split_windows", "jit"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[5,3] at "
-        "applications/inertial/windows.py:split_windows"
-    ),
     ("rk.inertial.states_from_trajectory", "jit"): (
         "TracerArrayConversionError: The numpy.ndarray conversion method "
         "__array__() was called on traced array with shape float64[3,6] at "
@@ -109,11 +104,6 @@ FAILS = {
         "__array__() was called on traced array with shape float64[3,6] at "
         "applications/inertial/simulation.py:_pose_and_twists"
     ),
-    ("rk.inertial.split_windows", "vmap"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[5,3] at "
-        "applications/inertial/windows.py:split_windows"
-    ),
     ("rk.inertial.states_from_trajectory", "vmap"): (
         "TracerArrayConversionError: The numpy.ndarray conversion method "
         "__array__() was called on traced array with shape float64[3,6] at "
@@ -158,11 +148,6 @@ FAILS = {
         "TracerArrayConversionError: The numpy.ndarray conversion method "
         "__array__() was called on traced array with shape float64[3,6] at "
         "applications/inertial/simulation.py:_pose_and_twists"
-    ),
-    ("rk.inertial.split_windows", "grad"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[5,3] at "
-        "applications/inertial/windows.py:split_windows"
     ),
     ("rk.inertial.states_from_trajectory", "grad"): (
         "TracerArrayConversionError: The numpy.ndarray conversion method "
@@ -307,11 +292,6 @@ FAILS = {
         "tensor.detach().numpy() instead. at "
         "applications/inertial/simulation.py:_pose_and_twists"
     ),
-    ("rk.inertial.split_windows", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead. at "
-        "applications/inertial/windows.py:split_windows"
-    ),
     ("rk.inertial.states_from_trajectory", "torch_grad"): (
         "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
         "tensor.detach().numpy() instead. at "
@@ -433,10 +413,6 @@ FAILS = {
         "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
         "storage at applications/inertial/simulation.py:_pose_and_twists"
     ),
-    ("rk.inertial.split_windows", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
-        "storage at applications/inertial/windows.py:split_windows"
-    ),
     ("rk.inertial.states_from_trajectory", "torch_vmap"): (
         "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
         "storage at applications/inertial/simulation.py:states_from_trajectory"
@@ -538,9 +514,6 @@ FAILS = {
     ),
     ("rk.inertial.preintegrate", "dask"): (
         "AssertionError: outputs returned computed, not lazily: ['ndarray', 'ndarray']"
-    ),
-    ("rk.inertial.split_windows", "dask"): (
-        "AssertionError: the call computed the graph 2 time(s)"
     ),
     ("rk.inertial.states_from_trajectory", "dask"): (
         "DegenerateInputError: control_points: 2 given, at least 4 needed at "
