@@ -44,3 +44,20 @@ def test_warning_survives_pickling():
     w = rk.GimbalLockWarning("gimbal lock at batch index (3,)", index=(3,))
     back = pickle.loads(pickle.dumps(w))
     assert back.index == (3,) and str(back) == str(w)
+
+
+@pytest.mark.parametrize("fn", ["euler_from_quat", "euler_from_quat_unchecked"])
+def test_warn_false_gives_the_same_angles_without_a_warning(fn):
+    # At lock in one element of a batch: warn=False records nothing (and touches no
+    # warning filter); the angles are those of the warning call, bit for bit.
+    euler = getattr(rk.functional.euler, fn)
+    angles = np.array([[10.0, 20.0, 30.0], [10.0, 90.0, 30.0]])
+    q = rk.functional.euler.quat_from_euler("ZYX", angles, degrees=True)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        quiet = euler("ZYX", q, degrees=True, warn=False)
+        filters = list(warnings.filters)
+        loud = euler("ZYX", q, degrees=True)
+    assert [w.category for w in caught] == [rk.GimbalLockWarning]
+    assert filters[0][0] == "always"  # the recording's own filter, left in place
+    np.testing.assert_array_equal(quiet, loud)

@@ -150,7 +150,7 @@ def _concat(a, extra):
     return namespace_of(a).concat([a, *extra], axis=-1)
 
 
-def euler_from_quat(seq, quat, *, degrees=False):
+def euler_from_quat(seq, quat, *, degrees=False, warn=True):
     """Euler angles of unit quaternions, for any of the 24 sequences.
 
     Conventions: UPPERCASE ``seq`` = intrinsic (body axes), lowercase = extrinsic
@@ -182,6 +182,11 @@ def euler_from_quat(seq, quat, *, degrees=False):
         :class:`~rigidkit.Rotation`'s) :func:`euler_from_quat_unchecked` skips the
         checks.
     degrees : bool
+    warn : bool
+        ``False`` skips the gimbal-lock check and its warning (the angles are the
+        same). Unlike ``warnings.catch_warnings()``, which swaps the process-wide
+        warning state and so may hide or let escape the warnings of other threads,
+        this leaves every warning filter alone.
 
     Returns
     -------
@@ -201,7 +206,7 @@ def euler_from_quat(seq, quat, *, degrees=False):
     Warns
     -----
     GimbalLockWarning
-        Once per call, when any middle angle is within
+        Unless ``warn=False``: once per call, when any middle angle is within
         :func:`gimbal_lock_threshold` (1.5e-8 rad for float64) of the lock (0 or pi
         for proper sequences, +-pi/2 for Tait-Bryan ones). There only the sum or
         difference of the first and third angle is well determined; the angles
@@ -234,14 +239,14 @@ def euler_from_quat(seq, quat, *, degrees=False):
     except (KeyError, TypeError, AttributeError):
         s = parse_sequence(seq)  # the sequence first: its error is the likelier one
         if type(quat) is not np.ndarray:
-            return _euler_from_quat_validated(s, quat, degrees)
+            return _euler_from_quat_validated(s, quat, degrees, warn)
         e = _call_record(seq, degrees, quat.dtype)
     s = e.sequence
     dt = quat.dtype
     if type(quat) is not np.ndarray or not (dt is _F64 or dt is _F32):
-        return _euler_from_quat_validated(s, quat, degrees)
+        return _euler_from_quat_validated(s, quat, degrees, warn)
     if quat.shape[-1:] != (4,):  # the general path raises the ShapeError
-        return _euler_from_quat_validated(s, quat, degrees)
+        return _euler_from_quat_validated(s, quat, degrees, warn)
     # Validated in the kernel's own pass (see kernels.euler.euler_from_quat_checked):
     # a row that is not finite, zero or of extreme scale has a middle angle of
     # 8 rad, which the lock scan below sends on to the full check.
@@ -249,14 +254,17 @@ def euler_from_quat(seq, quat, *, degrees=False):
     if lock_free(angles, e.band):
         return angles
     if bool((angles[..., 1] > 4.0 * e.scale).any()):
-        return _euler_from_quat_validated(s, quat, degrees)
-    warn_if_locked(s, angles, e.scale)
+        return _euler_from_quat_validated(s, quat, degrees, warn)
+    if warn:
+        warn_if_locked(s, angles, e.scale)
     return angles
 
 
-def _euler_from_quat_validated(s: EulerSequence, quat, degrees):
+def _euler_from_quat_validated(s: EulerSequence, quat, degrees, warn=True):
     """The general path of :func:`euler_from_quat`: validate first (any namespace)."""
-    return euler_from_quat_unchecked(s.text, _checked_quat(quat), degrees=degrees)
+    return euler_from_quat_unchecked(
+        s.text, _checked_quat(quat), degrees=degrees, warn=warn
+    )
 
 
 _F64 = np.dtype(np.float64)
@@ -293,13 +301,14 @@ def _checked_quat(quat):
     return xp.where(moderate[..., None], q, unit)
 
 
-def euler_from_quat_unchecked(seq, quat, *, degrees=False):
+def euler_from_quat_unchecked(seq, quat, *, degrees=False, warn=True):
     """:func:`euler_from_quat` for unit quaternions, without normalising or checks.
 
     The quaternions are taken as they are (the object layer's, unit by
     construction): NaN gives NaN angles, never an error; the kernel is homogeneous
     of degree 0, so a moderately scaled ``q`` gives its rotation's angles and a
-    zero one zero angles. Same conventions, ranges and gimbal-lock warning.
+    zero one zero angles. Same conventions, ranges and gimbal-lock warning
+    (``warn=False`` skips it, leaving every warning filter alone).
 
     >>> import numpy as np
     >>> q = np.array([np.sqrt(0.5), 0.0, 0.0, np.sqrt(0.5)])  # a quarter turn about z
@@ -311,7 +320,7 @@ def euler_from_quat_unchecked(seq, quat, *, degrees=False):
     except (KeyError, TypeError, AttributeError):
         e = _call_record(seq, degrees, _dtype(quat))
     angles = _k.euler_from_quat(*e.params, quat)
-    if type(angles) is np.ndarray and lock_free(angles, e.band):
+    if not warn or (type(angles) is np.ndarray and lock_free(angles, e.band)):
         return angles
     warn_if_locked(e.sequence, angles, e.scale)
     return angles
@@ -375,11 +384,11 @@ def matrix_from_euler(seq, angles, *, degrees=False):
     return _conv.matrix_from_quat_unchecked(quat_from_euler(seq, angles, degrees=degrees))
 
 
-def euler_from_matrix(seq, matrix, *, degrees=False, atol=None):
+def euler_from_matrix(seq, matrix, *, degrees=False, atol=None, warn=True):
     """Euler angles of rotation matrices (validated, see ``quat_from_matrix``).
 
     Conventions: UPPERCASE ``seq`` = intrinsic, lowercase = extrinsic. Ranges and
-    the gimbal-lock warning as in :func:`euler_from_quat`.
+    the gimbal-lock warning (``warn=False`` skips it) as in :func:`euler_from_quat`.
 
     See Also
     --------
@@ -393,4 +402,4 @@ def euler_from_matrix(seq, matrix, *, degrees=False, atol=None):
     array([ 0.,  0., 90.])
     """
     q = _conv.quat_from_matrix(matrix, atol=atol)  # validated, unit
-    return euler_from_quat_unchecked(seq, q, degrees=degrees)
+    return euler_from_quat_unchecked(seq, q, degrees=degrees, warn=warn)
