@@ -8,6 +8,9 @@ from __future__ import annotations
 import copy
 import pickle
 import sys
+import threading
+import time
+import warnings
 
 import numpy as np
 import pytest
@@ -185,3 +188,62 @@ def test_from_quat_one_pass_still_checks(quats, bad):
     if bad == 0.0:
         with pytest.raises(ValueError):
             sst.Rotation.from_quat(q)
+
+
+def test_suppress_warnings_leaves_other_threads_recording_alone():
+    # as_euler(suppress_warnings=True) at gimbal lock in one thread while another
+    # records its own warnings: the recording holds exactly that thread's warning
+    # every time. (warnings.catch_warnings() in the suppressing thread swapped the
+    # process-wide filters and showwarning: the recorder lost its "always" filter
+    # or its list, and got a stray GimbalLockWarning.)
+    locked = Rotation.from_euler("ZYX", [[10.0, 90.0, 30.0]] * 4, degrees=True)
+    expected = sst.Rotation.from_quat(locked.as_quat()).as_euler(
+        "ZYX", degrees=True, suppress_warnings=True
+    )
+    stop, bad, calls = threading.Event(), [], [0]
+
+    def suppress():
+        while not stop.is_set():
+            angles = locked.as_euler("ZYX", degrees=True, suppress_warnings=True)
+            calls[0] += 1
+            if not np.allclose(angles, expected, atol=1e-9):
+                bad.append(angles)
+
+    switch = sys.getswitchinterval()
+    sys.setswitchinterval(1e-6)
+    worker = threading.Thread(target=suppress)
+    worker.start()
+    lost = 0
+    try:
+        for k in range(2000):
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                time.sleep(0)  # the other thread runs inside this block
+                warnings.warn(f"mine {k}", UserWarning, stacklevel=1)
+            lost += [str(w.message) for w in caught] != [f"mine {k}"]
+    finally:
+        stop.set()
+        worker.join()
+        sys.setswitchinterval(switch)
+    assert calls[0] > 0 and not bad
+    assert lost == 0, f"{lost} of 2000 recordings disturbed ({calls[0]} calls)"
+
+
+def test_rotation_promoted_in_composition_and_tuple_indexing(quats, rng):
+    # scipy 1.18 composes a Rotation with a RigidTransform either way (the
+    # rotation promoted); checked against scipy's matrices of the promoted product.
+    t = rng.standard_normal((6, 3))
+    tf, r = RigidTransform.from_components(t, Rotation.from_quat(quats)), Rotation(quats)
+    s_tf = sst.RigidTransform.from_components(t, sst.Rotation.from_quat(quats))
+    s_r = sst.RigidTransform.from_rotation(sst.Rotation.from_quat(quats))
+    for ours, theirs in ((tf * r, s_tf * s_r), (r * tf, s_r * s_tf)):
+        assert isinstance(ours, RigidTransform)
+        np.testing.assert_allclose(ours.as_matrix(), theirs.as_matrix(), atol=1e-14)
+    # A tuple index holding an index array (was: "truth value ... ambiguous"
+    # for transforms) selects as the bare array does (NumPy's a[(i,)] == a[i]).
+    idx = [4, 0, 2]
+    want = s_tf[idx].as_matrix()
+    np.testing.assert_allclose(tf[(np.array(idx),)].as_matrix(), want, atol=1e-14)
+    np.testing.assert_allclose(tf[idx].as_matrix(), want, atol=1e-14)
+    want = sst.Rotation(quats)[idx].as_quat()
+    np.testing.assert_allclose(r[(np.array(idx),)].as_quat(), want, atol=1e-15)

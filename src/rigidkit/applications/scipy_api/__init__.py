@@ -8,7 +8,8 @@ composes), computed by rigidkit's own objects (``.as_rigidkit()``). See
 """
 
 from .rigid_transform import RigidTransform
-from .rotation import Rotation, Slerp
+from .rotation import Rotation
+from .slerp import Slerp
 from .spline import RotationSpline
 
 __all__ = ["Rotation", "RigidTransform", "Slerp", "RotationSpline"]

@@ -15,11 +15,11 @@ import math
 
 import numpy as np
 
-from ..._engine.namespace import namespace_of
-from ...objects.rotation import Rotation as _RkRotation
 from ...objects.transform import Transform as _RkTransform
 from ._arrays import as_float
-from .rotation import Rotation, _broadcast, _det3, _exponent, _new, _shape_arg
+from ._checks import broadcast, det3, exponent, shape_arg
+from ._container import Batch
+from .rotation import Rotation, _new
 
 __all__ = ["RigidTransform"]
 
@@ -51,7 +51,7 @@ def _matrix_in(matrix):
     return m
 
 
-class RigidTransform:
+class RigidTransform(Batch):
     """Rigid transforms in 3 dimensions, with scipy's API (``RigidTransform``).
 
     A drop-in replacement: ``from rigidkit.scipy import RigidTransform``.
@@ -72,10 +72,11 @@ class RigidTransform:
     """
 
     __slots__ = ("_t",)
+    _NAME, _NOUN, _NO_LEN = "RigidTransform", "transform", "Single transform has no len"
 
     def __init__(self, matrix, normalize=True, copy=True):
         m = _matrix_in(matrix)
-        if normalize and bool((_det3(m[..., :3, :3]) <= 0).any()):
+        if normalize and bool((det3(m[..., :3, :3]) <= 0).any()):
             raise ValueError(
                 "Non-positive determinant (left-handed or null coordinate frame) in "
                 "rotation matrix."
@@ -120,7 +121,7 @@ class RigidTransform:
             raise TypeError(
                 f"Expected `rotation` to be a `Rotation` instance, got {type(rotation)}."
             )
-        _broadcast(rotation.shape, tuple(t.shape[:-1]), "rotations")
+        broadcast(rotation.shape, tuple(t.shape[:-1]), "rotations")
         return _tf(_RkTransform(rotation=rotation._r, translation=t))
 
     @staticmethod
@@ -150,7 +151,7 @@ class RigidTransform:
         if num is not None and shape is not None:
             raise ValueError("Only one of `num` and `shape` can be specified.")
         try:
-            shp = _shape_arg(num, shape)
+            shp = shape_arg(num, shape)
         except ValueError:
             raise ValueError("`shape` must be an int or a tuple of ints or None.") from None
         return _tf(_RkTransform.identity(shp))
@@ -214,7 +215,7 @@ class RigidTransform:
             raise ValueError(
                 f"Expected vector to have shape (..., 3), got {tuple(v.shape)}."
             )
-        shape = self.shape
+        shape = tuple(self._t._pose.shape[:-1])
         if shape and v.ndim > 1:
             try:
                 np.broadcast_shapes(shape, tuple(v.shape[:-1]))
@@ -224,14 +225,22 @@ class RigidTransform:
 
     def __mul__(self, other):
         if not isinstance(other, RigidTransform):
-            return NotImplemented
+            if not isinstance(other, Rotation):
+                return NotImplemented
+            other = RigidTransform.from_rotation(other)  # scipy 1.18's promotion
         sa, sb = self.shape, other.shape
         if sa != sb and sa and sb:
-            _broadcast(sa, sb, "transforms")
+            broadcast(sa, sb, "transforms")
         return _tf(self._t @ other._t)
 
+    def __rmul__(self, other):
+        # Rotation * RigidTransform (Rotation.__mul__ declines): the rotation promoted.
+        if isinstance(other, Rotation):
+            return RigidTransform.from_rotation(other) * self
+        return NotImplemented
+
     def __pow__(self, n):
-        return _tf(self._t ** _exponent(n))
+        return _tf(self._t ** exponent(n))
 
     def inv(self):
         """The inverse transforms."""
@@ -265,65 +274,15 @@ class RigidTransform:
         return self.as_matrix()
 
     @property
-    def single(self):
-        """Whether this holds one transform (batch shape ``()``)."""
-        return self._t._pose.ndim == 1
+    def _data(self):
+        return self._t._pose
 
-    @property
-    def shape(self):
-        """The batch shape."""
-        return tuple(self._t._pose.shape[:-1])
+    @staticmethod
+    def _from_data(pose):
+        return _tf(_wrap_tf(pose))
 
-    def __len__(self):
-        if self._t._pose.ndim == 1:
-            raise TypeError("Single transform has no len")
-        return self._t._pose.shape[0]
-
-    def __bool__(self):
-        return True
-
-    def __getitem__(self, indexer):
-        p = self._t._pose
-        if p.ndim == 1:
-            raise TypeError("Single transform is not subscriptable.")
-        if isinstance(indexer, list):
-            indexer = np.asarray(indexer, dtype=np.intp if not indexer else None)
-        if isinstance(indexer, tuple):
-            out = (
-                p[indexer + (Ellipsis, slice(None))]
-                if Ellipsis not in indexer
-                else p[indexer + (slice(None),)]
-            )
-        else:
-            out = p[indexer]
-        return _tf(_wrap_tf(out))
-
-    def __setitem__(self, indexer, value):
-        p = self._t._pose
-        if p.ndim == 1:
-            raise TypeError("Single transform is not subscriptable.")
-        if not isinstance(value, RigidTransform):
-            raise TypeError("value must be a RigidTransform object")
-        if type(p) is np.ndarray:
-            p = np.array(p)
-            p[indexer] = value._t._pose
-        elif hasattr(p, "clone"):
-            p = p.clone()
-            p[indexer] = value._t._pose
-        else:
-            p = p.at[indexer].set(value._t._pose)
-        self._t = _wrap_tf(p)
-
-    def __iter__(self):
-        if self._t._pose.ndim == 1:
-            raise TypeError("Single transform is not iterable.")
-        for k in range(len(self)):
-            yield self[k]
-
-    def __repr__(self):
-        m = f"{self.as_matrix()!r}".splitlines()
-        m[1:] = [" " * 27 + line for line in m[1:]]
-        return "RigidTransform.from_matrix(" + "\n".join(m) + ")"
+    def _store(self, pose):
+        self._t = _wrap_tf(pose)
 
     def __reduce__(self):
         p = self._t._pose
@@ -334,4 +293,4 @@ def _unpickle(pose):
     return _tf(_wrap_tf(pose))
 
 
-_ = (namespace_of, _RkRotation)
+RigidTransform._KIND = RigidTransform

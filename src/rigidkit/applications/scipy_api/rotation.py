@@ -1,10 +1,12 @@
-"""``rigidkit.scipy.Rotation`` and ``Slerp``: scipy's API, rigidkit's computations.
+"""``rigidkit.scipy.Rotation``: scipy's API, rigidkit's computations.
 
 Every method has the signature, defaults and semantics of
 ``scipy.spatial.transform.Rotation`` (quaternions ``(x, y, z, w)`` unless
 ``scalar_first=True``, ``*`` composes, ``apply`` rotates vectors); the work is done
 by :class:`rigidkit.Rotation`, which the wrapper holds (``as_rigidkit()``). Unlike
 rigidkit's own objects the wrapper is mutable where scipy's is (``r[i] = ...``).
+scipy's argument checks are in ``_checks``, the container protocol (shared with
+``RigidTransform``) in ``_container``.
 """
 
 from __future__ import annotations
@@ -15,18 +17,28 @@ import numpy as np
 
 from ...errors import NotARotationError, RigidkitError
 from ...functional import conversions as _conv
+from ...functional import euler as _euler
 from ...kernels import pose_formats as _kpf
 from ...objects.rotation import Rotation as _RkRotation
 from ..alignment import align_vectors as _align_vectors
-from ..interpolation import Slerp as _RkSlerp
-from ._arrays import as_float, scalar
+from ._arrays import as_float, canonical_sign, scalar, wxyz, xyzw
+from ._checks import (
+    align_args,
+    broadcast,
+    check_trail,
+    davenport_order,
+    det3,
+    exponent,
+    generator,
+    shape_arg,
+)
+from ._container import Batch
 
-__all__ = ["Rotation", "Slerp"]
+__all__ = ["Rotation"]
 
 _wrap_rk = _RkRotation._wrap
 _quat_from_xyzw = _kpf.quat_from_xyzw
 _axis_angle = _conv.axis_angle_from_quat_unchecked
-_xyzw_from_quat = _kpf.xyzw_from_quat
 _from_quat_rk = _RkRotation.from_quat
 
 
@@ -37,34 +49,7 @@ def _new(r):
     return obj
 
 
-def _check_trail(x, trail, what):
-    shape = tuple(x.shape)
-    if shape[len(shape) - len(trail) :] != trail or len(shape) < len(trail):
-        text = ", ".join(str(t) for t in trail)
-        raise ValueError(f"Expected `{what}` to have shape (..., {text}), got {shape}.")
-
-
-def _shape_arg(num, shape):
-    if num is not None and shape is not None:
-        raise ValueError("Only one of `num` or `shape` can be specified.")
-    if shape is not None:
-        if isinstance(shape, (int, np.integer)):
-            return (int(shape),)
-        if not isinstance(shape, tuple) or not all(
-            isinstance(s, (int, np.integer)) for s in shape
-        ):
-            raise ValueError("`shape` must be an int or a tuple of ints.")
-        return shape
-    return () if num is None else (num,)
-
-
-def _rng(rng):
-    if isinstance(rng, (np.random.RandomState, np.random.Generator)):
-        return rng
-    return np.random.default_rng(rng)
-
-
-class Rotation:
+class Rotation(Batch):
     """Rotations in 3 dimensions, with scipy's API (``scipy.spatial.transform.Rotation``).
 
     A drop-in replacement: ``from rigidkit.scipy import Rotation``. Quaternions
@@ -87,14 +72,15 @@ class Rotation:
     """
 
     __slots__ = ("_r",)
+    _NAME, _NOUN, _NO_LEN = "Rotation", "rotation", "Single rotation has no len()."
 
     def __init__(self, quat, normalize=True, copy=True, scalar_first=False):
         q = as_float(quat)
-        _check_trail(q, (4,), "quat")
+        check_trail(q, (4,), "quat")
         if normalize:
             self._r = _from_quat_rk(q, scalar_first=scalar_first)
         else:  # stored as given (rigidkit keeps (w, x, y, z): a copy when reordered)
-            self._r = _wrap_rk((q.copy() if copy else q) if scalar_first else _wxyz(q))
+            self._r = _wrap_rk((q.copy() if copy else q) if scalar_first else wxyz(q))
 
     # -- construction ------------------------------------------------------------------
     @staticmethod
@@ -103,7 +89,7 @@ class Rotation:
         ``scalar_first=True``."""
         q = as_float(quat)
         if q.shape[-1:] != (4,):
-            _check_trail(q, (4,), "quat")
+            check_trail(q, (4,), "quat")
         if not scalar_first and type(q) is np.ndarray:
             # One pass (reorder and normalise); a zero or non-finite norm sends the
             # call to rigidkit's checked path, which raises naming the batch index.
@@ -131,7 +117,7 @@ class Rotation:
             return _new(_RkRotation.from_matrix(m))
         except NotARotationError:
             pass
-        if bool((_det3(m) <= 0).any()):
+        if bool((det3(m) <= 0).any()):
             raise ValueError(
                 "Non-positive determinant (left-handed or null coordinate frame) in "
                 "rotation matrix."
@@ -178,7 +164,7 @@ class Rotation:
     def from_davenport(axes, order, angles, degrees=False):
         """From Davenport angles about 1 to 3 axes (``order`` "e" or "i")."""
         axes, angles = as_float(axes), as_float(angles)
-        _davenport_order(order)
+        davenport_order(order)
         n = 1 if axes.ndim == 1 else axes.shape[-2]
         if (angles.ndim == 0 and n != 1) or (angles.ndim and angles.shape[-1] != n):
             raise ValueError(
@@ -196,17 +182,17 @@ class Rotation:
     @staticmethod
     def identity(num=None, *, shape=None):
         """The identity rotation: single, ``num`` of them, or batch ``shape``."""
-        return _new(_RkRotation.identity(_shape_arg(num, shape)))
+        return _new(_RkRotation.identity(shape_arg(num, shape)))
 
     @staticmethod
     def random(num=None, rng=None, *, shape=None, random_state=None):
         """Uniformly distributed rotations (normalised 4-D Gaussian samples, drawn as
         scipy draws them: the same ``rng`` gives the same rotations; ``random_state``
         is scipy's legacy name of ``rng``)."""
-        shp = _shape_arg(num, shape)
-        if random_state is not None:
-            rng = random_state
-        sample = _rng(rng).normal(size=shp + (4,))
+        shp = shape_arg(num, shape)
+        sample = generator(rng if random_state is None else random_state).normal(
+            size=shp + (4,)
+        )
         return _new(_from_quat_rk(sample, scalar_first=False))
 
     @staticmethod
@@ -242,56 +228,7 @@ class Rotation:
     def align_vectors(a, b, weights=None, return_sensitivity=False):
         """The rotation best aligning ``b`` to ``a`` (Wahba), with scipy's returns:
         ``(rotation, rssd)`` or ``(rotation, rssd, sensitivity)``."""
-        a_in, b_in = as_float(a), as_float(b)
-        a2 = a_in[None] if a_in.ndim == 1 else a_in
-        b2 = b_in[None] if b_in.ndim == 1 else b_in
-        if a2.shape[-1] != 3:
-            raise ValueError(
-                f"Expected input `a` to have shape (3,) or (N, 3), got {tuple(a_in.shape)}"
-            )
-        if b2.shape[-1] != 3:
-            raise ValueError(
-                f"Expected input `b` to have shape (3,) or (N, 3), got {tuple(b_in.shape)}"
-            )
-        if a2.shape != b2.shape:
-            raise ValueError(
-                "Expected inputs `a` and `b` to have same shapes, got "
-                f"{tuple(a_in.shape)} and {tuple(b_in.shape)} respectively."
-            )
-        if a2.ndim > 2:
-            raise ValueError(
-                "Expected inputs `a` and `b` to have shape (3,) or (N, 3), got "
-                f"{tuple(a_in.shape)} and {tuple(b_in.shape)} respectively."
-            )
-        n = a2.shape[0]
-        if weights is not None:
-            w = as_float(weights)
-            if w.ndim != 1:
-                raise ValueError(
-                    f"Expected `weights` to be 1 dimensional, got shape {tuple(w.shape)}."
-                )
-            if n > 1 and w.shape[0] != n:
-                raise ValueError(
-                    "Expected `weights` to have number of values equal to number of "
-                    f"input vectors, got {w.shape[0]} values and {n} vectors."
-                )
-            if bool((w < 0).any()):
-                raise ValueError("`weights` may not contain negative values")
-            n_inf = int((w == math.inf).sum())
-            if n_inf > 1:
-                raise ValueError("Only one infinite weight is allowed")
-            if n_inf == 1 or n == 1:
-                weights = w = (w * 0 + math.inf) if n == 1 else w
-                _primary_nonzero(a2, b2, w)
-        elif n == 1:
-            _primary_nonzero(a2, b2, None)
-        if return_sensitivity and (
-            n == 1 or (weights is not None and bool((w == math.inf).any()))
-        ):
-            raise ValueError(
-                "Cannot return sensitivity matrix with an infinite weight or one "
-                "vector pair"
-            )
+        a2, b2, weights = align_args(a, b, weights, return_sensitivity)
         out = _align_vectors(a2, b2, weights, return_sensitivity=return_sensitivity)
         result = (_new(out[0]), scalar(out[1]))
         return result + ((out[2],) if return_sensitivity else ())
@@ -302,10 +239,10 @@ class Rotation:
         ``canonical=True`` gives ``w >= 0`` (scipy's tie-breaking)."""
         q = self._r._quat
         if canonical:
-            q = _canonical(q)
+            q = canonical_sign(q)
         if scalar_first:
             return q.copy() if hasattr(q, "copy") else q.clone()
-        return _xyzw(q)
+        return xyzw(q)
 
     def as_matrix(self):
         """Rotation matrices, shape (..., 3, 3)."""
@@ -323,14 +260,16 @@ class Rotation:
         """Euler angles for a 3-axis ``seq``, shape (..., 3); a gimbal lock warns
         (a :class:`~rigidkit.GimbalLockWarning`, a ``UserWarning``) unless
         ``suppress_warnings=True``."""
-        if suppress_warnings:
-            return _quiet(self._r.as_euler, seq, degrees=degrees)
-        return self._r.as_euler(seq, degrees=degrees)
+        # warn=False, not warnings.catch_warnings(): that swaps the process-wide
+        # warning state (before Python 3.14), hiding other threads' warnings.
+        return _euler.euler_from_quat_unchecked(
+            seq, self._r._quat, degrees=degrees, warn=not suppress_warnings
+        )
 
     def as_davenport(self, axes, order, degrees=False, *, suppress_warnings=False):
         """Davenport angles about three axes, shape (..., 3)."""
         axes = as_float(axes)
-        _davenport_order(order)
+        davenport_order(order)
         try:
             if suppress_warnings:
                 return _quiet(self._r.as_davenport, axes, order, degrees=degrees)
@@ -359,7 +298,7 @@ class Rotation:
             raise ValueError(f"Expected input of shape (..., 3), got {tuple(v.shape)}.")
         shape = self._r._quat.shape[:-1]
         if shape and v.ndim > 1:
-            _broadcast(shape, tuple(v.shape[:-1]))
+            broadcast(shape, tuple(v.shape[:-1]))
         return self._r.apply(v, inverse=inverse)
 
     def __mul__(self, other):
@@ -368,13 +307,13 @@ class Rotation:
         a, b = self._r, other._r
         sa, sb = a._quat.shape[:-1], b._quat.shape[:-1]
         if sa != sb and sa and sb:
-            _broadcast(sa, sb, "rotations")
+            broadcast(sa, sb, "rotations")
         return _new(a @ b)
 
     def __pow__(self, n, modulus=None):
         if modulus is not None:
             raise NotImplementedError("modulus not supported")
-        return _new(self._r ** _exponent(n))
+        return _new(self._r ** exponent(n))
 
     def inv(self):
         """The inverse rotations."""
@@ -466,71 +405,15 @@ class Rotation:
         return self._r._quat
 
     @property
-    def single(self):
-        """Whether this holds one rotation (batch shape ``()``)."""
-        return self._r._quat.ndim == 1
+    def _data(self):
+        return self._r._quat
 
-    @property
-    def shape(self):
-        """The batch shape."""
-        return tuple(self._r._quat.shape[:-1])
+    @staticmethod
+    def _from_data(quat):
+        return _new(_wrap_rk(quat))
 
-    def __len__(self):
-        if self._r._quat.ndim == 1:
-            raise TypeError("Single rotation has no len().")
-        return self._r._quat.shape[0]
-
-    def __bool__(self):
-        return True
-
-    def __getitem__(self, indexer):
-        q = self._r._quat
-        if q.ndim == 1:
-            raise TypeError("Single rotation is not subscriptable.")
-        if isinstance(indexer, tuple) or indexer is Ellipsis:
-            idx = (indexer if isinstance(indexer, tuple) else (indexer,)) + (slice(None),)
-            if Ellipsis not in [i for i in idx if i is Ellipsis]:
-                idx = tuple(idx[:-1]) + (Ellipsis, slice(None))
-            out = q[idx]
-        else:
-            if isinstance(indexer, list):
-                indexer = np.asarray(indexer, dtype=np.intp if not indexer else None)
-            out = q[indexer]
-        return _new(_wrap_rk(out))
-
-    def __setitem__(self, indexer, value):
-        if self._r._quat.ndim == 1:
-            raise TypeError("Single rotation is not subscriptable.")
-        if not isinstance(value, Rotation):
-            raise TypeError("value must be a Rotation object")
-        q = self._r._quat
-        q = (
-            np.array(q)
-            if type(q) is np.ndarray
-            else q.clone()
-            if hasattr(q, "clone")
-            else q
-        )
-        if hasattr(q, "at") and not hasattr(q, "clone") and type(q) is not np.ndarray:
-            q = q.at[indexer].set(value._r._quat)
-        else:
-            q[indexer] = value._r._quat
-        self._r = _wrap_rk(q)
-
-    def __iter__(self):
-        if self._r._quat.ndim == 1:
-            raise TypeError("Single rotation is not iterable.")
-        for k in range(len(self)):
-            yield self[k]
-
-    def __repr__(self):
-        m = f"{self.as_matrix()!r}".splitlines()
-        # scipy's: the matrix repr indented under ``Rotation.from_matrix(``.
-        return (
-            "Rotation.from_matrix("
-            + "\n".join([m[0]] + [" " * 21 + line for line in m[1:]])
-            + ")"
-        )
+    def _store(self, quat):
+        self._r = _wrap_rk(quat)
 
     def __reduce__(self):
         return (_unpickle, (self.as_quat(scalar_first=True),))
@@ -546,87 +429,9 @@ def _unpickle(quat):
     return _new(_wrap_rk(quat))
 
 
-def _wxyz(q):
-    if type(q) is np.ndarray:
-        return np.concatenate([q[..., 3:], q[..., :3]], axis=-1)
-    return _cat(q[..., 3:], q[..., :3])
-
-
-_TO_XYZW = np.array([1, 2, 3, 0])
-
-
-def _xyzw(q):
-    if type(q) is np.ndarray:
-        return _xyzw_from_quat(q) if q.ndim > 1 else q.take(_TO_XYZW)
-    return _cat(q[..., 1:], q[..., :1])
-
-
-def _cat(a, b):
-    from ..._engine.namespace import namespace_of
-
-    return namespace_of(a).concat([a, b], axis=-1)
-
-
-def _canonical(q):
-    """``q`` or ``-q``: scipy's canonical sign (w > 0, ties broken by x, y, z)."""
-    from ..._engine.namespace import namespace_of
-
-    xp = namespace_of(q)
-    w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
-    flip = (w < 0) | ((w == 0) & ((x < 0) | ((x == 0) & ((y < 0) | ((y == 0) & (z < 0))))))
-    return xp.where(flip[..., None], -q, q)
-
-
-def _det3(m):
-    a, b, c = m[..., 0, :], m[..., 1, :], m[..., 2, :]
-    return (
-        a[..., 0] * (b[..., 1] * c[..., 2] - b[..., 2] * c[..., 1])
-        - a[..., 1] * (b[..., 0] * c[..., 2] - b[..., 2] * c[..., 0])
-        + a[..., 2] * (b[..., 0] * c[..., 1] - b[..., 1] * c[..., 0])
-    )
-
-
-def _broadcast(sa, sb, what=None):
-    try:
-        return np.broadcast_shapes(tuple(sa), tuple(sb))
-    except ValueError:
-        if what is None:
-            raise ValueError(
-                f"Cannot broadcast {tuple(sa)} rotations to {tuple(sb)} vectors "
-                "(operands could not be broadcast together)."
-            ) from None
-        raise ValueError(
-            f"Cannot broadcast {tuple(sa)} {what} in first to {tuple(sb)} {what} in "
-            "second object."
-        ) from None
-
-
-def _primary_nonzero(a, b, w):
-    k = 0 if w is None else int(np.argmax(np.asarray(w) == math.inf))
-    if not (bool((a[k] ** 2).sum() > 0) and bool((b[k] ** 2).sum() > 0)):
-        raise ValueError("Cannot align zero length primary vectors")
-
-
-def _exponent(n):
-    """A power's exponent as a float: a number or an array of one element (scipy's)."""
-    if isinstance(n, (int, float)):
-        return n
-    size = getattr(n, "size", None)
-    size = size() if callable(size) else size
-    if isinstance(n, (list, tuple)) or (size is not None and size != 1):
-        raise ValueError("Array exponent must be a scalar")
-    return float(n if size is None or getattr(n, "ndim", 0) == 0 else n.reshape(()))
-
-
-def _davenport_order(order):
-    if order not in ("e", "extrinsic", "i", "intrinsic"):
-        raise ValueError(
-            "order should be 'e'/'extrinsic' for extrinsic sequences or 'i'/"
-            f"'intrinsic' for intrinsic sequences, got {order!r}"
-        )
-
-
 def _quiet(fn, *args, **kwargs):
+    # Davenport angles only (Euler angles take warn=False): rigidkit's Davenport
+    # functions have no such option yet.
     import warnings
 
     from ...errors import GimbalLockWarning
@@ -636,61 +441,4 @@ def _quiet(fn, *args, **kwargs):
         return fn(*args, **kwargs)
 
 
-class Slerp:
-    """Spherical linear interpolation of rotations (scipy's ``Slerp``).
-
-    Parameters
-    ----------
-    times : array_like, shape (N,)
-        Strictly increasing times of the keyframes, ``N >= 2``.
-    rotations : Rotation, shape (N,)
-        The keyframes.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from rigidkit.scipy import Rotation, Slerp
-    >>> keys = Rotation.from_rotvec([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
-    >>> np.round(Slerp([0.0, 2.0], keys)(0.5).as_rotvec(), 12) + 0.0
-    array([0.  , 0.  , 0.25])
-    """
-
-    def __init__(self, times, rotations):
-        if not isinstance(rotations, Rotation):
-            raise TypeError("`rotations` must be a `Rotation` instance.")
-        if rotations.single or len(rotations) <= 1:
-            raise ValueError("`rotations` must be a sequence of at least 2 rotations.")
-        if len(rotations.shape) > 1:
-            raise ValueError(
-                "Rotations with more than 1 leading dimension are not supported."
-            )
-        t = as_float(times)
-        if t.ndim != 1:
-            raise ValueError(
-                "Expected times to be specified in a 1 dimensional array, got "
-                f"{t.ndim} dimensions."
-            )
-        if t.shape[0] != len(rotations):
-            raise ValueError(
-                "Expected number of rotations to be equal to number of timestamps "
-                f"given, got {len(rotations)} rotations and {t.shape[0]} timestamps."
-            )
-        if bool((t[1:] - t[:-1] <= 0).any()):
-            raise ValueError("Times must be in strictly increasing order.")
-        self.times = t
-        self.timedelta = t[1:] - t[:-1]
-        self.rotations = rotations[:-1]
-        self._slerp = _RkSlerp(t, rotations._r)
-
-    def __call__(self, times):
-        """The interpolated rotations at ``times`` (scalar or 1-D)."""
-        t = as_float(times)
-        if t.ndim > 1:
-            raise ValueError("`times` must be at most 1-dimensional.")
-        lo, hi = self.times[0], self.times[-1]
-        if bool(((t < lo) | (t > hi)).any()):
-            raise ValueError(
-                f"Interpolation times must be within the range [{lo}, {hi}], both "
-                "inclusive."
-            )
-        return _new(self._slerp(t))
+Rotation._KIND = Rotation
