@@ -25,17 +25,6 @@ import numpy as np
 import pytest
 
 sst = pytest.importorskip("scipy.spatial.transform")
-import scipy  # noqa: E402
-
-# scipy 1.18's test modules key their array-API marks by scipy's own classes
-# (make_xp_pytest_marks: KeyError on a substituted class at import); the harness
-# is written for scipy 1.17's suite, which CI's Python 3.11 job installs.
-if tuple(int(p) for p in scipy.__version__.split(".")[:2]) >= (1, 18):
-    pytest.skip(
-        f"scipy {scipy.__version__}'s suite keys its marks by scipy's classes; "
-        "the substitution harness covers scipy 1.17",
-        allow_module_level=True,
-    )
 TESTS = Path(sst.__file__).parent / "tests"
 FILES = {
     "rotation": "test_rotation.py",
@@ -72,11 +61,15 @@ DESELECTED = {
 
 
 def _capabilities():
-    """Register rigidkit's methods in scipy's table of array-API capabilities (the
-    test decorators read it), with the entries of scipy's methods of the same name."""
+    """Register rigidkit's classes and methods in scipy's table of array-API
+    capabilities (the test decorators read it at import), with the entries of
+    scipy's of the same name: scipy 1.17 keys the table by method, 1.18 by class
+    (``make_xp_pytest_marks((Rotation, "as_quat"))`` looks up ``Rotation``)."""
     table = _array_api.xp_capabilities_table
     for name in CLASSES:
         theirs, ours = getattr(sst, name), getattr(rks, name)
+        if theirs in table:
+            table[ours] = table[theirs]
         for attr in dir(theirs):
             f = getattr(theirs, attr, None)
             try:
@@ -88,8 +81,15 @@ def _capabilities():
 
 
 def _load(short, filename):
-    """Import one of scipy's test modules with rigidkit's classes in scipy's place."""
+    """Import one of scipy's test modules with rigidkit's classes in scipy's place.
+
+    scipy 1.18's decorators tag the methods they name for its lazy (JAX, Dask)
+    variants by replacing them with tagged clones (array_api_extra's
+    ``lazy_xp_function``); our classes' own methods are put back afterwards (the
+    ``xp`` fixture here is NumPy only, which reads no tag).
+    """
     saved = {name: getattr(sst, name) for name in CLASSES}
+    own = {name: dict(vars(getattr(rks, name))) for name in CLASSES}
     try:
         for name in CLASSES:
             setattr(sst, name, getattr(rks, name))
@@ -105,6 +105,13 @@ def _load(short, filename):
     finally:
         for name, cls in saved.items():
             setattr(sst, name, cls)
+        for name, attrs in own.items():
+            cls = getattr(rks, name)
+            for attr in set(vars(cls)) - set(attrs):
+                delattr(cls, attr)
+            for attr, value in attrs.items():
+                if vars(cls).get(attr) is not value:
+                    setattr(cls, attr, value)
 
 
 _capabilities()
