@@ -91,8 +91,7 @@ class Affine(BatchedArray, Group, family="space", rank=3):
             A = xp.asarray(np.eye(3), dtype=dt, device=dev)
         if t is None:
             t = xp.zeros((3,), dtype=dt, device=dev)
-        A = xp.asarray(A, dtype=dt)
-        t = xp.asarray(t, dtype=dt)
+        A, t = _cast(xp, A, dt), _cast(xp, t, dt)
         batch = tuple(np.broadcast_shapes(tuple(A.shape[:-2]), tuple(t.shape[:-1])))
         data = xp.concat(
             [
@@ -201,6 +200,16 @@ class Affine(BatchedArray, Group, family="space", rank=3):
         A = [row[:3] for row in d]
         t = [row[3] for row in d]
         return f"Affine(matrix={A!r}, translation={t!r})"
+
+
+def _cast(xp, a, dtype):
+    """``a`` with ``dtype``, in its own namespace: Dask arrays stay lazy (``asarray``
+    of one would compute it), torch tensors keep their graph."""
+    if a.dtype == dtype:
+        return a
+    if hasattr(a, "astype"):  # NumPy, JAX, Dask
+        return a.astype(dtype)
+    return xp.asarray(a, dtype=dtype)
 
 
 def _result_dtype(xp, a, b):
