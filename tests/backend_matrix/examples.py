@@ -330,7 +330,12 @@ INCLUDES = {
 
 
 def _eye(like, n):
-    return like[..., :n, :n] * 0 + np.eye(n)
+    """The n x n identity, batched like ``like``, in its namespace (a torch tensor
+    plus an ndarray converts the tensor to NumPy: no autograd, no vmap)."""
+    zero = like[..., :n, :n] * 0
+    if hasattr(zero, "new_tensor"):  # torch
+        return zero + zero.new_tensor(np.eye(n))
+    return zero + np.eye(n)
 
 
 def _group_examples(cname, k: Kind):
