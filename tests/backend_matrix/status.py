@@ -154,58 +154,6 @@ FAILS = {
         "__array__() was called on traced array with shape float64[3,6] at "
         "applications/inertial/simulation.py:states_from_trajectory"
     ),
-    ("rk.Affine.__getitem__", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Affine.__init__", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Affine.__matmul__", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Affine.apply", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Affine.as_matrix", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Affine.as_projective", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Affine.compose", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Affine.concatenate", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Affine.from_matrix", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Affine.inv", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Affine.matrix", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Affine.reshape", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Affine.translation", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
     ("rk.FrameGraph.__init__", "torch_grad"): (
         "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
         "tensor.detach().numpy() instead. at "
@@ -231,62 +179,6 @@ FAILS = {
         "tensor.detach().numpy() instead. at "
         "applications/frames/buffer.py:as_samples"
     ),
-    ("rk.Projective.__getitem__", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Projective.__init__", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Projective.__matmul__", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Projective.apply", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Projective.apply_homogeneous", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Projective.as_matrix", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Projective.as_projective", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Projective.compose", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Projective.concatenate", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Projective.from_affine", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Projective.from_matrix", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Projective.include", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Projective.inv", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
-    ("rk.Projective.reshape", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead."
-    ),
     ("rk.inertial.imu_from_trajectory", "torch_grad"): (
         "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
         "tensor.detach().numpy() instead. at "
@@ -296,48 +188,6 @@ FAILS = {
         "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
         "tensor.detach().numpy() instead. at "
         "applications/inertial/simulation.py:states_from_trajectory"
-    ),
-    ("rk.Affine.__getitem__", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Affine.__init__", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Affine.__matmul__", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Affine.apply", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Affine.approx_equal", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Affine.as_matrix", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Affine.as_projective", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Affine.compose", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Affine.concatenate", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Affine.from_matrix", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Affine.inv", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Affine.matrix", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Affine.reshape", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Affine.translation", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
     ),
     ("rk.FrameGraph.__init__", "torch_vmap"): (
         "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
@@ -359,51 +209,6 @@ FAILS = {
         "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
         "storage at applications/frames/buffer.py:as_samples"
     ),
-    ("rk.Projective.__getitem__", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Projective.__init__", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Projective.__matmul__", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Projective.apply", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Projective.apply_homogeneous", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Projective.approx_equal", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Projective.as_matrix", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Projective.as_projective", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Projective.compose", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Projective.concatenate", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Projective.from_affine", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Projective.from_matrix", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Projective.include", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Projective.inv", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
-    ("rk.Projective.reshape", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have storage"
-    ),
     ("rk.RotationSpline.__init__", "torch_vmap"): (
         "RuntimeError: vmap: It looks like you're calling .item() on a Tensor. "
         "We don't support vmap over calling .item() on a Tensor, please try to "
@@ -416,42 +221,6 @@ FAILS = {
     ("rk.inertial.states_from_trajectory", "torch_vmap"): (
         "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
         "storage at applications/inertial/simulation.py:states_from_trajectory"
-    ),
-    ("rk.Affine.__getitem__", "dask"): (
-        "AssertionError: the call computed the graph 2 time(s)"
-    ),
-    ("rk.Affine.__init__", "dask"): (
-        "AssertionError: the call computed the graph 2 time(s)"
-    ),
-    ("rk.Affine.__matmul__", "dask"): (
-        "AssertionError: the call computed the graph 4 time(s)"
-    ),
-    ("rk.Affine.apply", "dask"): ("AssertionError: the call computed the graph 2 time(s)"),
-    ("rk.Affine.approx_equal", "dask"): (
-        "AssertionError: the call computed the graph 4 time(s)"
-    ),
-    ("rk.Affine.as_matrix", "dask"): (
-        "AssertionError: the call computed the graph 2 time(s)"
-    ),
-    ("rk.Affine.as_projective", "dask"): (
-        "AssertionError: the call computed the graph 2 time(s)"
-    ),
-    ("rk.Affine.compose", "dask"): (
-        "AssertionError: the call computed the graph 4 time(s)"
-    ),
-    ("rk.Affine.concatenate", "dask"): (
-        "AssertionError: the call computed the graph 4 time(s)"
-    ),
-    ("rk.Affine.from_matrix", "dask"): (
-        "AssertionError: the call computed the graph 2 time(s)"
-    ),
-    ("rk.Affine.inv", "dask"): ("AssertionError: the call computed the graph 2 time(s)"),
-    ("rk.Affine.matrix", "dask"): ("AssertionError: the call computed the graph 2 time(s)"),
-    ("rk.Affine.reshape", "dask"): (
-        "AssertionError: the call computed the graph 2 time(s)"
-    ),
-    ("rk.Affine.translation", "dask"): (
-        "AssertionError: the call computed the graph 2 time(s)"
     ),
     ("rk.FrameGraph.__init__", "dask"): (
         "ShapeError: a static edge takes one pose, got a batch of shape (2,); "
@@ -475,12 +244,6 @@ FAILS = {
     ),
     ("rk.FrameGraph.velocity", "dask"): (
         "AssertionError: the call computed the graph 1 time(s)"
-    ),
-    ("rk.Projective.from_affine", "dask"): (
-        "AssertionError: the call computed the graph 2 time(s)"
-    ),
-    ("rk.Projective.include", "dask"): (
-        "AssertionError: the call computed the graph 2 time(s)"
     ),
     ("rk.Quaternion.__rmul__", "dask"): (
         "AssertionError: the call computed the graph 1 time(s)"
@@ -544,18 +307,6 @@ FAILS = {
     ("rk.sim3.right_jacobian_inverse", "dask"): (
         "ValueError: Dimension must be 2 to perform lu decomposition at "
         "functional/sim3.py:_left_jacobian_inverse"
-    ),
-    ("rk.trajectory.ape", "dask"): (
-        "AssertionError: the call computed the graph 2 time(s)"
-    ),
-    ("rk.trajectory.pair_indices", "dask"): (
-        "AssertionError: the call computed the graph 1 time(s)"
-    ),
-    ("rk.trajectory.rpe", "dask"): (
-        "AssertionError: the call computed the graph 2 time(s)"
-    ),
-    ("rk.trajectory.statistics", "dask"): (
-        "AssertionError: the call computed the graph 1 time(s)"
     ),
     ("rk.Transform.__matmul__", "compile"): (
         "Unsupported: Failed to trace builtin operator (torch.compile fullgraph)"
