@@ -17,10 +17,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..._engine.namespace import namespace_of
 from ...objects.extended_pose import ExtendedPose
 from ...objects.rotation import Rotation
 from .preintegration import ImuNoise
-from .strapdown import GRAVITY
+from .strapdown import GRAVITY, vector_like
 
 __all__ = ["imu_from_trajectory", "simulate_imu", "states_from_trajectory", "ImuLog"]
 
@@ -50,10 +51,20 @@ class ImuLog:
 
 
 def _pose_and_twists(trajectory, times):
+    """The poses and body twists in the trajectory's namespace (traced, lazy, on the
+    autograd graph: no conversion to NumPy)."""
     T = trajectory(times)
-    V = np.asarray(trajectory(times, 1, frame="body"))
-    A = np.asarray(trajectory(times, 2, frame="body"))
+    V = trajectory(times, 1, frame="body")
+    A = trajectory(times, 2, frame="body")
     return T, V, A
+
+
+def _cross(a, b):
+    """``a x b`` over the last axis, in the namespace of ``a`` and ``b``."""
+    xp = namespace_of(a, b)
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return xp.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
 
 
 def imu_from_trajectory(trajectory, times, *, gravity=GRAVITY, earth_rate=None):
@@ -90,16 +101,13 @@ def imu_from_trajectory(trajectory, times, *, gravity=GRAVITY, earth_rate=None):
     T, V, A = _pose_and_twists(trajectory, times)
     w, vb = V[..., 3:], V[..., :3]
     R = T.rotation
-    f = (
-        np.cross(w, vb)
-        + A[..., :3]
-        - R.apply(np.asarray(gravity, dtype=np.float64), inverse=True)
-    )
+    g = vector_like(gravity, V, "gravity")
+    f = _cross(w, vb) + A[..., :3] - R.apply(g, inverse=True)
     if earth_rate is not None:
-        W = np.asarray(earth_rate, dtype=np.float64)
-        p = np.asarray(T.translation)
+        W = vector_like(earth_rate, V, "earth_rate")
+        p = T.translation
         v = R.apply(vb)
-        extra = 2.0 * np.cross(W, v) + np.cross(W, np.cross(W, p))
+        extra = 2.0 * _cross(W, v) + _cross(W, _cross(W, p))
         f = f + R.apply(extra, inverse=True)
         w = w + R.apply(W, inverse=True)
     return w, f
@@ -118,7 +126,7 @@ def states_from_trajectory(trajectory, times):
            [1., 0., 0.]]), array([1., 3.]))
     """
     T = trajectory(times)
-    V = np.asarray(trajectory(times, 1, frame="body"))
+    V = trajectory(times, 1, frame="body")
     R = T.rotation
     return ExtendedPose(
         rotation=Rotation._wrap(R._quat),
