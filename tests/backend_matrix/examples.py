@@ -902,11 +902,13 @@ ex(
     _i + "imu_from_trajectory",
     lambda x: ine.imu_from_trajectory(rk.BSplineSE3(T_(x)), _TQ),
     _CTRL,
+    series=True,
 )
 ex(
     _i + "states_from_trajectory",
     lambda x: ine.states_from_trajectory(rk.BSplineSE3(T_(x)), _TQ).as_matrix(),
     _CTRL,
+    series=True,
 )
 na_all(_i + "simulate_imu", RANDOM + " (white noise and random walks)")
 
@@ -1000,6 +1002,8 @@ ex(
         "jit": SHAPE_BY_VALUE,
         "vmap": SHAPE_BY_VALUE,
         "torch_vmap": SHAPE_BY_VALUE,
+        "dask": "pairs in metres come from the distances travelled (a walk on the "
+        "host): their number, the output's shape, is known only once computed",
     },
 )
 ex(
