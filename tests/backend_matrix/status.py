@@ -54,16 +54,6 @@ FAILS = {
         "concrete value is expected: traced array with shape float64[] at "
         "functional/splines.py:rotation_spline_coefficients"
     ),
-    ("rk.inertial.imu_from_trajectory", "jit"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[3,6] at "
-        "applications/inertial/simulation.py:_pose_and_twists"
-    ),
-    ("rk.inertial.states_from_trajectory", "jit"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[3,6] at "
-        "applications/inertial/simulation.py:states_from_trajectory"
-    ),
     ("rk.FrameGraph.__init__", "vmap"): (
         "TracerArrayConversionError: The numpy.ndarray conversion method "
         "__array__() was called on traced array with shape float64[7] at "
@@ -98,16 +88,6 @@ FAILS = {
         "ConcretizationTypeError: Abstract tracer value encountered where "
         "concrete value is expected: traced array with shape float64[] at "
         "functional/splines.py:rotation_spline_coefficients"
-    ),
-    ("rk.inertial.imu_from_trajectory", "vmap"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[3,6] at "
-        "applications/inertial/simulation.py:_pose_and_twists"
-    ),
-    ("rk.inertial.states_from_trajectory", "vmap"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[3,6] at "
-        "applications/inertial/simulation.py:states_from_trajectory"
     ),
     ("rk.FrameGraph.__init__", "grad"): (
         "TracerArrayConversionError: The numpy.ndarray conversion method "
@@ -144,16 +124,6 @@ FAILS = {
         "concrete value is expected: traced array with shape float64[] at "
         "functional/splines.py:rotation_spline_coefficients"
     ),
-    ("rk.inertial.imu_from_trajectory", "grad"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[3,6] at "
-        "applications/inertial/simulation.py:_pose_and_twists"
-    ),
-    ("rk.inertial.states_from_trajectory", "grad"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[3,6] at "
-        "applications/inertial/simulation.py:states_from_trajectory"
-    ),
     ("rk.FrameGraph.__init__", "torch_grad"): (
         "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
         "tensor.detach().numpy() instead. at "
@@ -179,16 +149,6 @@ FAILS = {
         "tensor.detach().numpy() instead. at "
         "applications/frames/buffer.py:as_samples"
     ),
-    ("rk.inertial.imu_from_trajectory", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead. at "
-        "applications/inertial/simulation.py:_pose_and_twists"
-    ),
-    ("rk.inertial.states_from_trajectory", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead. at "
-        "applications/inertial/simulation.py:states_from_trajectory"
-    ),
     ("rk.FrameGraph.__init__", "torch_vmap"): (
         "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
         "storage at applications/frames/buffer.py:as_samples"
@@ -213,14 +173,6 @@ FAILS = {
         "RuntimeError: vmap: It looks like you're calling .item() on a Tensor. "
         "We don't support vmap over calling .item() on a Tensor, please try to "
         "rewrite what y at functional/splines.py:rotation_spline_coefficients"
-    ),
-    ("rk.inertial.imu_from_trajectory", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
-        "storage at applications/inertial/simulation.py:_pose_and_twists"
-    ),
-    ("rk.inertial.states_from_trajectory", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
-        "storage at applications/inertial/simulation.py:states_from_trajectory"
     ),
     ("rk.FrameGraph.__init__", "dask"): (
         "ShapeError: a static edge takes one pose, got a batch of shape (2,); "
@@ -268,19 +220,11 @@ FAILS = {
         "but the array at index 0 has 2 dimension(s) and the array at index 1 "
         "has 3 dimensi at applications/inertial/preintegration.py:<listcomp>"
     ),
-    ("rk.inertial.imu_from_trajectory", "dask"): (
-        "DegenerateInputError: control_points: 2 given, at least 4 needed at "
-        "applications/interpolation.py:keyframe_kind"
-    ),
     ("rk.inertial.integrate", "dask"): (
         "AssertionError: the call computed the graph 1 time(s)"
     ),
     ("rk.inertial.preintegrate", "dask"): (
         "AssertionError: outputs returned computed, not lazily: ['ndarray', 'ndarray']"
-    ),
-    ("rk.inertial.states_from_trajectory", "dask"): (
-        "DegenerateInputError: control_points: 2 given, at least 4 needed at "
-        "applications/interpolation.py:keyframe_kind"
     ),
     ("rk.kinematics.integrate_angular_velocity", "dask"): (
         "AssertionError: the call computed the graph 1 time(s)"
