@@ -197,17 +197,22 @@ def test_suppress_warnings_leaves_other_threads_recording_alone():
     # process-wide filters and showwarning: the recorder lost its "always" filter
     # or its list, and got a stray GimbalLockWarning.)
     locked = Rotation.from_euler("ZYX", [[10.0, 90.0, 30.0]] * 4, degrees=True)
-    expected = sst.Rotation.from_quat(locked.as_quat()).as_euler(
-        "ZYX", degrees=True, suppress_warnings=True
-    )
+    theirs = sst.Rotation.from_quat(locked.as_quat())
+    expected = theirs.as_euler("ZYX", degrees=True, suppress_warnings=True)
+    axes = np.eye(3)[::-1]  # Davenport angles about z, y, x: the same lock
+    expected_dav = theirs.as_davenport(axes, "i", degrees=True, suppress_warnings=True)
     stop, bad, calls = threading.Event(), [], [0]
 
     def suppress():
         while not stop.is_set():
             angles = locked.as_euler("ZYX", degrees=True, suppress_warnings=True)
+            dav = locked.as_davenport(axes, "i", degrees=True, suppress_warnings=True)
             calls[0] += 1
-            if not np.allclose(angles, expected, atol=1e-9):
-                bad.append(angles)
+            if not (
+                np.allclose(angles, expected, atol=1e-9)
+                and np.allclose(dav, expected_dav, atol=1e-9)
+            ):
+                bad.append((angles, dav))
 
     switch = sys.getswitchinterval()
     sys.setswitchinterval(1e-6)

@@ -245,13 +245,14 @@ def davenport_from_quat(axes, order, quat, *, degrees=False):
 _LOCK_TEXT = {0: "intrinsic Davenport axes", 1: "extrinsic Davenport axes"}
 
 
-def davenport_from_quat_unchecked(axes, order, quat, *, degrees=False):
+def davenport_from_quat_unchecked(axes, order, quat, *, degrees=False, warn=True):
     """:func:`davenport_from_quat` for unit quaternions (no checks of ``quat``).
 
     The axes are still validated. Algorithm: reduction to the proper Euler
     sequence ``XYX`` in a frame built from the axes (see
     :func:`rigidkit.kernels.davenport.davenport_from_quat`), then the Euler
-    kernel, accurate to a few ulp also near the lock.
+    kernel, accurate to a few ulp also near the lock. ``warn=False`` skips the
+    gimbal-lock warning without touching any warning filter.
 
     >>> import numpy as np
     >>> axes = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 1.0]]  # n1, n3 at 45 deg
@@ -267,7 +268,8 @@ def davenport_from_quat_unchecked(axes, order, quat, *, degrees=False):
     angles, aux = _k.davenport_from_quat(
         rev, scale, tol, q, unit[..., 0, :], unit[..., 1, :], unit[..., 2, :]
     )
-    warn_if_locked(_LOCK_SEQ[rev], aux, scale)
+    if warn:
+        warn_if_locked(_LOCK_SEQ[rev], aux, scale)
     return _nan_where_bad(angles, bad)
 
 

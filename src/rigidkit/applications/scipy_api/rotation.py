@@ -17,6 +17,7 @@ import numpy as np
 
 from ...errors import NotARotationError, RigidkitError
 from ...functional import conversions as _conv
+from ...functional import davenport as _dav
 from ...functional import euler as _euler
 from ...kernels import pose_formats as _kpf
 from ...objects.rotation import Rotation as _RkRotation
@@ -271,9 +272,9 @@ class Rotation(Batch):
         axes = as_float(axes)
         davenport_order(order)
         try:
-            if suppress_warnings:
-                return _quiet(self._r.as_davenport, axes, order, degrees=degrees)
-            return self._r.as_davenport(axes, order, degrees=degrees)
+            return _dav.davenport_from_quat_unchecked(
+                axes, order, self._r._quat, degrees=degrees, warn=not suppress_warnings
+            )
         except RigidkitError as err:
             if "orthogonal" in str(err):
                 raise ValueError("Consecutive axes must be orthogonal.") from err
@@ -427,18 +428,6 @@ class Rotation(Batch):
 
 def _unpickle(quat):
     return _new(_wrap_rk(quat))
-
-
-def _quiet(fn, *args, **kwargs):
-    # Davenport angles only (Euler angles take warn=False): rigidkit's Davenport
-    # functions have no such option yet.
-    import warnings
-
-    from ...errors import GimbalLockWarning
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", GimbalLockWarning)
-        return fn(*args, **kwargs)
 
 
 Rotation._KIND = Rotation
