@@ -197,21 +197,6 @@ FAILS = {
     ("rk.FrameGraph.velocity", "dask"): (
         "AssertionError: the call computed the graph 1 time(s)"
     ),
-    ("rk.Quaternion.__rmul__", "dask"): (
-        "AssertionError: the call computed the graph 1 time(s)"
-    ),
-    ("rk.Quaternion.__truediv__", "dask"): (
-        "AssertionError: the call computed the graph 1 time(s)"
-    ),
-    ("rk.Quaternion.from_parts", "dask"): (
-        "AssertionError: the call computed the graph 2 time(s)"
-    ),
-    ("rk.Rotation2D.as_complex", "dask"): (
-        "AssertionError: the call computed the graph 2 time(s)"
-    ),
-    ("rk.conversions.nearest_rotation_matrix", "dask"): (
-        "ValueError: Array must be 2D. at functional/conversions.py:nearest_rotation_matrix"
-    ),
     ("rk.inertial.Preintegrated.corrected", "dask"): (
         "AssertionError: the call computed the graph 2 time(s)"
     ),
@@ -225,32 +210,6 @@ FAILS = {
     ),
     ("rk.inertial.preintegrate", "dask"): (
         "AssertionError: outputs returned computed, not lazily: ['ndarray', 'ndarray']"
-    ),
-    ("rk.kinematics.integrate_angular_velocity", "dask"): (
-        "AssertionError: the call computed the graph 1 time(s)"
-    ),
-    ("rk.kinematics.integrate_angular_velocity[rk4]", "dask"): (
-        "AssertionError: the call computed the graph 1 time(s)"
-    ),
-    ("rk.kinematics.integrate_twist", "dask"): (
-        "AssertionError: the call computed the graph 1 time(s)"
-    ),
-    ("rk.kinematics.integrate_twist[midpoint]", "dask"): (
-        "AssertionError: the call computed the graph 1 time(s)"
-    ),
-    ("rk.kinematics.planar.integrate_angular_velocity", "dask"): (
-        "AssertionError: the call computed the graph 1 time(s)"
-    ),
-    ("rk.kinematics.planar.integrate_twist", "dask"): (
-        "AssertionError: the call computed the graph 1 time(s)"
-    ),
-    ("rk.sim3.left_jacobian_inverse", "dask"): (
-        "ValueError: Dimension must be 2 to perform lu decomposition at "
-        "functional/sim3.py:_left_jacobian_inverse"
-    ),
-    ("rk.sim3.right_jacobian_inverse", "dask"): (
-        "ValueError: Dimension must be 2 to perform lu decomposition at "
-        "functional/sim3.py:_left_jacobian_inverse"
     ),
     ("rk.Transform.__matmul__", "compile"): (
         "Unsupported: Failed to trace builtin operator (torch.compile fullgraph)"

@@ -34,11 +34,13 @@ from __future__ import annotations
 
 import math
 import os
+from functools import partial
 
 import numpy as np
 
 from ..._engine import (
     compile_scan,
+    dask_backend,
     idle_workers,
     in_background,
     is_numpy,
@@ -106,6 +108,8 @@ def running_product(chain, body: int, x0, inc):
     chunks on NumPy, so that a scan that becomes ready during a long call serves
     the rest of it.
     """
+    if dask_backend.any_dask(x0, inc):
+        return _dask_product(chain, body, x0, inc)
     xp = namespace_of(x0, inc)
     width = inc.shape[-1]
     steps = inc.shape[-2]
@@ -125,6 +129,33 @@ def running_product(chain, body: int, x0, inc):
     ):
         return _jax_prefix()(chain, int(body), x0, inc, batch)
     return _prefix_product(chain, body, x0, inc, batch, xp)
+
+
+def _dask_product(chain, body, x0, inc):
+    """:func:`running_product` of Dask arrays, lazily: each chunk of the batch is
+    one NumPy call (the compiled scan or the prefix product) with the step axis
+    whole (the scan runs along it); the batch axes stay chunked as given."""
+    import dask.array as da
+
+    width = inc.shape[-1]
+    steps = inc.shape[-2]
+    batch = _broadcast(tuple(x0.shape[:-1]), tuple(inc.shape[:-2]))
+    x0 = da.broadcast_to(da.asarray(x0), batch + (width,))
+    inc = da.broadcast_to(da.asarray(inc), batch + (steps, width))
+    dtype = np.result_type(x0.dtype, inc.dtype)
+    return dask_backend.map_batched(
+        partial(running_product, chain, body),
+        [x0, inc],
+        [1, 2],
+        outputs=[((steps + 1, width), dtype)],
+    )
+
+
+def _dask_sum(inc):
+    """:func:`running_sum` of a Dask array: per chunk of the batch, the step axis
+    whole."""
+    shape = (inc.shape[-2] + 1, inc.shape[-1])
+    return dask_backend.map_batched(running_sum, [inc], [2], outputs=[(shape, inc.dtype)])
 
 
 def _broadcast(a: tuple, b: tuple) -> tuple:
@@ -221,6 +252,8 @@ def running_sum(inc):
     product of an abelian group written additively (SO(2) angles), by the same
     prefix scheme (rounding grows with ``log N``, where ``cumsum``'s grows with
     ``N``)."""
+    if dask_backend.any_dask(inc):
+        return _dask_sum(inc)
     xp = namespace_of(inc)
     seq = xp.concat([0.0 * inc[..., :1, :], inc], axis=-2)
     return _prefixes(lambda a, b: a + b, seq, xp)

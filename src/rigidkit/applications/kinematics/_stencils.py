@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..._engine import dask_backend
 from ..._engine.namespace import device_of, is_numpy, namespace_of
 from ..._validate import raise_where
 from ...errors import DegenerateInputError
@@ -96,6 +97,8 @@ def rates_at_step_points(rate, h, *, order: int):
     numpy = is_numpy(xp)
 
     def conv(a):
+        if numpy and dask_backend.is_dask(a):  # weights from Dask steps stay lazy
+            return a.astype(rate.dtype)
         if numpy:
             return np.asarray(a, dtype=rate.dtype)
         return xp.asarray(a, dtype=rate.dtype, device=device_of(rate))

@@ -247,6 +247,9 @@ def integrate_twist(T0, twist, dt, *, frame, method="exact"):
 def _like(x0, rate):
     """``x0`` in the namespace, dtype and device of the rates."""
     xp = namespace_of(rate)
+    if dask_backend.is_dask(x0) or dask_backend.is_dask(rate):
+        dtype = np.result_type(x0.dtype, rate.dtype)
+        return x0.astype(dtype) if dask_backend.is_dask(x0) else np.asarray(x0, dtype)
     if is_numpy(xp):
         return np.asarray(x0, dtype=np.result_type(x0.dtype, rate.dtype))
     return xp.asarray(x0, dtype=rate.dtype, device=device_of(rate))
