@@ -15,8 +15,8 @@ alone when it is missing; every other test of the file still runs. Three spellin
 
 ``pytest.importorskip`` at module level is not used: it skips every test of the file.
 
-Compiled loops: the suite runs with ``RIGIDKIT_BACKGROUND_COMPILE=0`` (set here
-unless the environment says otherwise), so a batch whose loop is not ready is
+Compiled loops: the test processes run as with ``RIGIDKIT_BACKGROUND_COMPILE=0``
+(unless the environment sets that variable), so a batch whose loop is not ready is
 served by the Python-float and element-wise NumPy bindings, and no loop is compiled
 speculatively for each broadcast pattern and dtype a test happens to meet (on a
 cold cache, hundreds of 1-3 s compiles per test process: most of CI's time). Every
@@ -35,10 +35,15 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, settings
 
-# Before rigidkit is imported (read once, at import): see the module docstring.
-os.environ.setdefault("RIGIDKIT_BACKGROUND_COMPILE", "0")
+from rigidkit.objects import registry
 
-from rigidkit.objects import registry  # noqa: E402
+# The module (rigidkit._engine's ``kernel`` is the decorator).
+_kernel = importlib.import_module("rigidkit._engine.kernel")
+
+# See the module docstring. Set on the engine, not in the environment: processes the
+# tests start (the CLI, fresh-process checks of the loader) run as users get them.
+if "RIGIDKIT_BACKGROUND_COMPILE" not in os.environ:
+    _kernel.BACKGROUND = False
 
 # torch's setup (bindings, adapter, pytree nodes) once per test process, where torch
 # is installed: as the doctest collection of rigidkit._engine.torch_setup did before
@@ -110,9 +115,7 @@ dask_array = _backend_fixture("dask_array")
 def background_compiles(monkeypatch):
     """The engine as users get it: loops not ready are compiled in the background
     (the suite runs without, see the module docstring)."""
-    from rigidkit._engine import kernel
-
-    monkeypatch.setattr(kernel, "BACKGROUND", True)
+    monkeypatch.setattr(_kernel, "BACKGROUND", True)
 
 
 @pytest.fixture
