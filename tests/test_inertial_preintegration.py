@@ -265,6 +265,32 @@ def test_split_windows_keeps_float32(rng):
     np.testing.assert_allclose(dt.sum(axis=-1), [0.25, 0.25], rtol=1e-6)
 
 
+def test_residual_broadcasts_windows_against_states(rng):
+    """A batch of windows against one pair of states (and one window against a batch
+    of states) gives each pair's residual and Jacobians, as the calls one by one."""
+    w, f = log(rng, 3 * 12)
+    pim = rk.inertial.preintegrate(
+        w.reshape(3, 12, 3), f.reshape(3, 12, 3), 0.01, gyro_bias=[0.01, 0.0, -0.02]
+    )
+    Xi, Xj = rk.ExtendedPose.random((), rng), rk.ExtendedPose.random((), rng)
+    bg = np.array([0.02, -0.01, 0.03])
+    got = pim.residual(Xi, Xj, gravity=G, gyro_bias=bg)
+    for k in range(3):
+        one = pim[k].residual(Xi, Xj, gravity=G, gyro_bias=bg)
+        for a, b in zip(got, one):
+            np.testing.assert_allclose(
+                a[k], b, rtol=0, atol=1e-15 * max(1, np.abs(b).max())
+            )
+    Xs = rk.ExtendedPose.random((4,), rng)
+    got = pim[1].residual(Xs, Xj, gravity=G, gyro_bias=bg)
+    for k in range(4):
+        one = pim[1].residual(Xs[k], Xj, gravity=G, gyro_bias=bg)
+        for a, b in zip(got, one):
+            np.testing.assert_allclose(
+                a[k], b, rtol=0, atol=1e-15 * max(1, np.abs(b).max())
+            )
+
+
 def test_float32_and_batches(rng):
     w, f = log(rng, 16)
     pim = rk.inertial.preintegrate(

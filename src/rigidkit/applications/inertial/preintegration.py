@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..._engine.dask_backend import is_dask
 from ..._engine.namespace import device_of, is_numpy, namespace_of
 from ...functional import so3 as _so3
 from ...kernels.kinematics import inertial as _k
@@ -223,14 +224,15 @@ class Preintegrated:
         JRg = self._jacobian[..., :3, :3]
         Jr_db = _so3.right_jacobian(_mv(JRg, dbg))
         JbR = -xp.matmul(xp.matmul(Jri, _swap(E.as_matrix())), xp.matmul(Jr_db, JRg))
-        J_bg = xp.concat([JbR, -self._jacobian[..., 3:, :3]], axis=-2)
-        J_ba = xp.concat([zero, -self._jacobian[..., 3:, 3:]], axis=-2)
+        J_bg = _cat([JbR, -self._jacobian[..., 3:, :3]], -2, xp)
+        J_ba = _cat([zero, -self._jacobian[..., 3:, 3:]], -2, xp)
         return r, J_i, J_j, J_bg, J_ba
 
 
 def _swap(M):
-    """The transposes of a stack of matrices (``.mT``: NumPy, torch and JAX alike)."""
-    return M.mT
+    """The transposes of a stack of matrices (``.mT``: NumPy, torch and JAX alike;
+    Dask's arrays have ``swapaxes`` only)."""
+    return M.swapaxes(-1, -2) if is_dask(M) else M.mT
 
 
 def _mv(M, v):
@@ -238,7 +240,18 @@ def _mv(M, v):
 
 
 def _blocks(rows, xp):
-    return xp.concat([xp.concat(r, axis=-1) for r in rows], axis=-2)
+    return _cat([_cat(r, -1, xp) for r in rows], -2, xp)
+
+
+def _cat(parts, axis, xp):
+    """``parts`` (..., a, b) joined along ``axis`` (-1 or -2), their batch shapes
+    broadcast first (windows against states, as the other terms broadcast)."""
+    batch = np.broadcast_shapes(*(tuple(x.shape[:-2]) for x in parts))
+    parts = [
+        x if tuple(x.shape[:-2]) == batch else xp.broadcast_to(x, batch + x.shape[-2:])
+        for x in parts
+    ]
+    return xp.concat(parts, axis=axis)
 
 
 def _cast(a, like):
@@ -367,6 +380,10 @@ def _preintegrate(w, f, h, bg, ba, noise, method, xp):
     cov = None if noise is None else _symmetric(xp.sum(C, axis=-2), xp)
     J = -xp.sum(M, axis=-3)
     batch = tuple(J.shape[:-2])
+    if is_dask(J):  # the biases too are Dask arrays, as every other field
+        import dask.array as da
+
+        xp, bg, ba = da, da.asarray(bg), da.asarray(ba)
     bg = xp.broadcast_to(bg, batch + (3,))
     ba = xp.broadcast_to(ba, batch + (3,))
     return Preintegrated(end[..., 0, :], J, cov, bg, ba)

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..._engine.dask_backend import is_dask
 from ..._engine.namespace import device_of, is_numpy, namespace_of
 from ..._validate import finite_array
 from ...errors import ShapeError
@@ -64,6 +65,8 @@ def samples(gyro, accel, fn):
 def vector_like(v, like, what):
     """A 3-vector (or batch of them) in the namespace, dtype and device of ``like``."""
     v = finite_array(v, (3,), what)
+    if is_dask(v):
+        return v.astype(like.dtype)
     xp = namespace_of(like)
     if is_numpy(xp):
         return np.asarray(v, dtype=like.dtype)
@@ -180,7 +183,9 @@ def predict_states(x0, D, gravity, earth_rate):
 
 
 def _cast(x, like):
-    """``x`` in the namespace and dtype of ``like``."""
+    """``x`` in the namespace and dtype of ``like`` (a Dask array stays lazy)."""
+    if is_dask(x):
+        return x.astype(like.dtype)
     xp = namespace_of(like)
     if is_numpy(xp):
         return np.asarray(x, dtype=like.dtype)
