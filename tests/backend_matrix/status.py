@@ -197,20 +197,6 @@ FAILS = {
     ("rk.FrameGraph.velocity", "dask"): (
         "AssertionError: the call computed the graph 1 time(s)"
     ),
-    ("rk.inertial.Preintegrated.corrected", "dask"): (
-        "AssertionError: the call computed the graph 2 time(s)"
-    ),
-    ("rk.inertial.Preintegrated.residual", "dask"): (
-        "ValueError: all the input arrays must have same number of dimensions, "
-        "but the array at index 0 has 2 dimension(s) and the array at index 1 "
-        "has 3 dimensi at applications/inertial/preintegration.py:<listcomp>"
-    ),
-    ("rk.inertial.integrate", "dask"): (
-        "AssertionError: the call computed the graph 1 time(s)"
-    ),
-    ("rk.inertial.preintegrate", "dask"): (
-        "AssertionError: outputs returned computed, not lazily: ['ndarray', 'ndarray']"
-    ),
     ("rk.Transform.__matmul__", "compile"): (
         "Unsupported: Failed to trace builtin operator (torch.compile fullgraph)"
     ),
