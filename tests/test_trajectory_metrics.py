@@ -543,3 +543,37 @@ def test_statistics_of_torch_and_jax_errors_are_differentiable():
     (gt,) = torch.autograd.grad(rk.trajectory.statistics(t)["rmse"], t)
     rtol = 1e-12 if x.dtype == jax.numpy.float64 else 1e-6
     np.testing.assert_allclose(np.asarray(gj), gt.numpy(), rtol=rtol)
+
+
+@pytest.mark.parametrize(
+    "relation", ["translation", "rotation_angle", "rotation_part", "full", "point_distance"]
+)
+def test_dask_poses_give_lazy_metrics_equal_to_numpy(dask_array, relation):
+    """APE and RPE (pairs by frames: from the length alone) of Dask poses compute
+    nothing during the call, and equal the NumPy path's errors and statistics
+    (which compute np.median, np.std... on the host: an independent reference)."""
+    da = dask_array
+    from dask.callbacks import Callback
+
+    computes = []
+
+    class Count(Callback):
+        def _start(self, dsk):
+            computes.append(1)
+
+    t = np.arange(9) * 0.1
+    a, b = rk.Transform.random(9, rng=3), rk.Transform.random(9, rng=4)
+
+    def lazy(T):
+        return rk.Trajectory(t, rk.Transform.from_pq(da.from_array(T.as_pq(), chunks=4)))
+
+    for metric, kw in ((ape, {}), (rpe, {"delta": 2})):
+        want = metric(rk.Trajectory(t, a), rk.Trajectory(t, b), relation=relation, **kw)
+        with Count():
+            got = metric(lazy(a), lazy(b), relation=relation, **kw)
+        assert not computes, (metric.__name__, len(computes))
+        assert type(got.errors).__module__.startswith("dask")
+        np.testing.assert_allclose(got.errors.compute(), want.errors, rtol=0, atol=1e-14)
+        for key, value in want.stats.items():
+            assert type(got.stats[key]).__module__.startswith("dask"), key
+            np.testing.assert_allclose(got.stats[key].compute(), value, rtol=1e-13)

@@ -1,4 +1,4 @@
-"""APE and RPE in the poses' own array namespace (torch, JAX, ...): differentiable.
+"""APE and RPE in the poses' own array namespace (torch, JAX, Dask...): differentiable.
 
 The NumPy path of :mod:`.metrics` is tuned for speed on the host; this one
 computes the same numbers with the operations of the poses' namespace, so that
@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..._engine.dask_backend import is_dask
 from ..._engine.namespace import is_torch
 from ...errors import ShapeError
 
@@ -37,9 +38,13 @@ def _norm(xp, v):
 
 
 def _sort(x):
-    """``x`` sorted along its last axis (torch and the array API name it apart)."""
+    """``x`` sorted along its last axis (torch and the array API name it apart;
+    Dask, which has no sort, per block after joining the last axis into one chunk,
+    lazily)."""
     if is_torch(x):
         return x.sort(dim=-1).values
+    if is_dask(x):
+        return x.rechunk({x.ndim - 1: -1}).map_blocks(np.sort, axis=-1, dtype=x.dtype)
     return x.__array_namespace__().sort(x, axis=-1)
 
 

@@ -51,16 +51,14 @@ def statistics(errors) -> dict:
     squares, as evo reports them.
 
     A torch or JAX array gives arrays of its namespace instead (0-d for one
-    series), differentiable, as ``ape`` and ``rpe`` report them on such poses.
+    series), differentiable, as ``ape`` and ``rpe`` report them on such poses; a
+    Dask array gives lazy Dask arrays (nothing is computed by the call).
 
     >>> bool(statistics(np.array([3.0, 4.0]))["rmse"] == np.sqrt(12.5))
     True
     """
-    if (
-        not isinstance(errors, (np.ndarray, np.generic))
-        and hasattr(errors, "shape")
-        and not dask_backend.is_dask(errors)
-    ):
+    if not isinstance(errors, (np.ndarray, np.generic)) and hasattr(errors, "shape"):
+        # torch, JAX and Dask (NumPy's functions dispatch to its lazy ones)
         return _array_metrics.statistics(namespace_of(errors), errors)
     e = np.asarray(errors, dtype=np.float64)
     n = e.shape[-1]
@@ -152,11 +150,12 @@ def _check(relation, ref, est):
 
 
 def _namespace(ref, est):
-    """The poses' namespace where the metrics compute in it (torch, JAX, ...);
-    None for NumPy and Dask, computed in NumPy on the host."""
+    """The poses' namespace where the metrics compute in it (torch, JAX, ...;
+    NumPy's functions for Dask, which dispatch to its lazy ones); None for NumPy,
+    computed by the NumPy path tuned for the host."""
     a, b = stored(ref.poses), stored(est.poses)
     if dask_backend.any_dask(a, b):
-        return None
+        return np
     xp = namespace_of(a, b)
     return None if is_numpy(xp) else xp
 
@@ -403,7 +402,8 @@ def rpe(
         pairs = _checked_pairs(pairs, len(ref))
     else:
         if xp is not None and unit != "frames":  # chosen from values: on the host
-            if not concrete(stored(chooser.poses)):
+            a = stored(chooser.poses)
+            if not concrete(a) and not dask_backend.is_dask(a):  # Dask: computed
                 raise RigidkitError(
                     f"rpe: pairs {delta!r} {unit} apart are chosen from the poses' "
                     "values, which are traced here (jax.jit, jax.grad, torch.compile); "
