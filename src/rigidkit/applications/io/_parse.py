@@ -95,63 +95,47 @@ def _loop(buf, ncols, exact, delim, pow10, out, lines, slow):
             neg = c == 45
             pos += 1
         # The fast scan: every digit into mant (exact while there are at most
-        # 18 of them: mant < 10^18 < 2^63); more digits are scanned again below.
-        digits = pos
+        # 18 of them: mant < 10^18 < 2^63), with at most one point among them;
+        # more digits are scanned again below.
+        first = pos
         mant = 0
+        point = -1  # where the fraction's digits begin, once a point is read
         while pos < n:
             d = np.int64(buf[pos]) - 48
-            if d < 0 or d > 9:
-                break
-            mant = mant * 10 + d
-            pos += 1
-        seen = pos - digits
-        frac = 0
-        if pos < n and buf[pos] == 46:
-            pos += 1
-            fstart = pos
-            while pos < n:
-                d = np.int64(buf[pos]) - 48
-                if d < 0 or d > 9:
-                    break
+            if d >= 0 and d <= 9:
                 mant = mant * 10 + d
-                pos += 1
-            frac = pos - fstart
-            seen += frac
+            elif d == -2 and point < 0:  # '.'
+                point = pos + 1
+            else:
+                break
+            pos += 1
+        frac = 0 if point < 0 else pos - point
+        seen = pos - first - (0 if point < 0 else 1)
         drop = 0
         inexact = False
         if seen > 18:
-            # The careful scan: the first 18 significant digits into mant, the
-            # rest counted (the integer part's) or checked to be zeros.
-            pos = digits
+            # The careful scan of the same digits: the first 18 significant ones
+            # into mant, the rest counted (the integer part's) or checked to be
+            # zeros.
             mant = 0
             ndig = 0
-            while pos < n:
-                d = np.int64(buf[pos]) - 48
-                if d < 0 or d > 9:
-                    break
+            frac = 0
+            fstart = pos if point < 0 else point
+            for k in range(first, pos):
+                d = np.int64(buf[k]) - 48
+                if d == -2:  # the point
+                    continue
                 if ndig < 18:
                     if mant > 0 or d != 0:
                         ndig += 1
                     mant = mant * 10 + d
-                else:
+                    if k >= fstart:
+                        frac += 1
+                elif k < fstart:  # a digit of the integer part
                     drop += 1
                     inexact = True
-                pos += 1
-            frac = 0
-            if pos < n and buf[pos] == 46:
-                pos += 1
-                while pos < n:
-                    d = np.int64(buf[pos]) - 48
-                    if d < 0 or d > 9:
-                        break
-                    if ndig < 18:
-                        if mant > 0 or d != 0:
-                            ndig += 1
-                        mant = mant * 10 + d
-                        frac += 1
-                    elif d != 0:
-                        inexact = True
-                    pos += 1
+                elif d != 0:
+                    inexact = True
         exp = 0
         good = seen > 0
         if good and pos < n and (buf[pos] == 101 or buf[pos] == 69):
