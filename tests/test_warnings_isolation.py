@@ -124,3 +124,58 @@ def test_shim_keeps_warnings_on_an_isolated_thread():
     got = [(str(w.message), w.filename, w.lineno) for w in inner]
     assert got == [("numba's", "f.py", 3)]
     assert str(compile_warnings.compile_warnings()[-1].message) == "unrecorded"
+
+
+_FIRST_COMPILE = textwrap.dedent(
+    """
+    import json, sys, threading, warnings
+    import numpy as np
+
+    # Every call that changes the process's warning state, by thread name.
+    seen = []
+    real_enter = warnings.catch_warnings.__enter__
+    def enter(self):
+        seen.append(("catch_warnings", threading.current_thread().name))
+        return real_enter(self)
+    warnings.catch_warnings.__enter__ = enter
+    for name in ("filterwarnings", "simplefilter", "resetwarnings"):
+        real = getattr(warnings, name)
+        def spy(*a, _real=real, _name=name, **k):
+            seen.append((_name, threading.current_thread().name))
+            return _real(*a, **k)
+        setattr(warnings, name, spy)
+
+    assert "scipy" not in sys.modules
+    import rigidkit as rk
+    R = rk.Rotation.random(3, rng=0)
+    # A cold cache: numba's first compile, with its BLAS probe's scipy import.
+    m = rk.kernels.so3.quat_from_rotvec(R.as_rotvec(), backend="numba")
+    print(json.dumps({
+        "compile_thread": [c for c in seen if c[1] == "rigidkit-numba"],
+        "scipy_util": "scipy._lib._util" in sys.modules,
+        "shim": type(sys.modules["scipy._lib._util"].warnings).__name__,
+        "warnings_module": sys.modules["warnings"] is warnings,
+    }))
+    """
+)
+
+
+def test_first_compile_imports_keep_warnings_on_the_compile_thread(tmp_path):
+    """numba's first compile imports scipy.linalg, whose ``scipy._lib._util``
+    enters ``catch_warnings`` in its body: on the compile thread that never
+    reaches the process's warning state (a cold cache, scipy not imported)."""
+    env = dict(os.environ, RIGIDKIT_CACHE_DIR=str(tmp_path))
+    env.pop("RIGIDKIT_DISABLE_NUMBA", None)
+    res = subprocess.run(
+        [sys.executable, "-c", _FIRST_COMPILE],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=240,
+    )
+    assert res.returncode == 0, res.stderr[-3000:]
+    out = json.loads(res.stdout.strip().splitlines()[-1])
+    pytest.importorskip("scipy")
+    assert out["scipy_util"], out  # the case arose
+    assert out["compile_thread"] == [], out
+    assert out["shim"] == "_Shim" and out["warnings_module"], out

@@ -20,14 +20,15 @@ of its own, the filter calls change nothing, and a warning issued there
 goes to the innermost such recording, or else to :func:`compile_warnings`, never
 to the process's filters and ``showwarning``. numba's import (run on that
 thread) and its loads from the disk cache (:func:`.numba_loads.jit_signatures`)
-touch none of that state at all (traced on numba 0.68). One case is left: a
-module of another package that numba's first compile in a process imports, on
-that thread, and that enters ``catch_warnings`` in its body: ``scipy._lib._util``
-does once, through numba's BLAS probe, when ``scipy.linalg`` was not imported
-before (a cold disk cache only).
+touch none of that state at all (traced on numba 0.68). numba's first compile
+in a process imports ``scipy.linalg`` (its BLAS probe), and ``scipy._lib._util``
+enters ``catch_warnings`` in its body: :func:`before_compile` makes that import
+first, on the compile thread, with :data:`SHIM` standing in for :mod:`warnings`
+while the modules bind it (the only warning calls of that import, traced on
+scipy 1.17 and 1.18).
 
 >>> import warnings
->>> SHIM.catch_warnings is not warnings.catch_warnings   # a function of the thread
+>>> SHIM.catch_warnings is not warnings.catch_warnings   # its own, per thread
 True
 >>> with SHIM.catch_warnings(record=True) as log:        # on this thread: warnings'
 ...     SHIM.simplefilter("always")
@@ -45,7 +46,13 @@ import types
 import warnings as _warnings
 from collections import deque
 
-__all__ = ["SHIM", "compile_warnings", "isolate", "isolate_numba_modules"]
+__all__ = [
+    "SHIM",
+    "before_compile",
+    "compile_warnings",
+    "isolate",
+    "isolate_numba_modules",
+]
 
 _LOCAL = threading.local()
 #: Warnings issued on the compile thread outside any recording of numba's (the
@@ -75,16 +82,6 @@ def compile_warnings() -> list:
     return list(_LOG)
 
 
-@contextlib.contextmanager
-def _catch(record=False, **_ignored):
-    log = []
-    _LOCAL.stack.append(log)
-    try:
-        yield log if record else None
-    finally:
-        _LOCAL.stack.pop()
-
-
 def _emit(message, category, filename, lineno):
     if isinstance(message, Warning):
         category = type(message)
@@ -92,10 +89,28 @@ def _emit(message, category, filename, lineno):
     (_LOCAL.stack[-1] if _LOCAL.stack else _LOG).append(msg)
 
 
-def catch_warnings(*args, **kwargs):
-    if _isolated():
-        return _catch(*args, **kwargs)
-    return _warnings.catch_warnings(*args, **kwargs)
+class catch_warnings(_warnings.catch_warnings):
+    # A class, not a function: modules subclass it (numpy.testing does at import).
+    # The thread that enters decides: isolated, a recording of its own.
+    _rk_log = None
+
+    def __enter__(self):
+        if not _isolated():
+            return super().__enter__()
+        self._rk_log = []
+        _LOCAL.stack.append(self._rk_log)
+        return self._rk_log if self._record else None
+
+    def __exit__(self, *exc_info):
+        if self._rk_log is None:
+            return super().__exit__(*exc_info)
+        stack = _LOCAL.stack
+        for i in range(len(stack) - 1, -1, -1):  # by identity (lists compare equal)
+            if stack[i] is self._rk_log:
+                del stack[i]
+                break
+        self._rk_log = None
+        return None
 
 
 def simplefilter(*args, **kwargs):
@@ -153,3 +168,44 @@ def isolate_numba_modules() -> int:
             module.warnings = SHIM
             count += 1
     return count
+
+
+#: Modules numba's first compile imports whose bodies use :mod:`warnings`.
+_FIRST_COMPILE_IMPORTS = ("scipy.linalg.cython_blas", "scipy.__config__")
+_PREPARED = False
+
+
+def before_compile() -> None:
+    """Called before numba compiles (not before a load from the disk cache).
+
+    On the isolated compile thread, once per process: the modules that numba's
+    first compile imports (:data:`_FIRST_COMPILE_IMPORTS`, where installed and
+    not yet imported) are imported with ``sys.modules["warnings"]`` set to
+    :data:`SHIM`, so their bodies' ``catch_warnings`` and filters stay on this
+    thread and the modules keep :data:`SHIM` (which is :mod:`warnings` on every
+    other thread). Elsewhere, or once done, nothing.
+    """
+    global _PREPARED
+    if _PREPARED or not _isolated():
+        return
+    _PREPARED = True
+    import importlib
+    import importlib.util
+
+    for name in _FIRST_COMPILE_IMPORTS:
+        if name in sys.modules:
+            continue
+        try:
+            if importlib.util.find_spec(name.split(".")[0]) is None:
+                continue
+        except (ImportError, ValueError):
+            continue
+        if sys.modules.get("warnings") is not _warnings:
+            return
+        sys.modules["warnings"] = SHIM
+        try:
+            importlib.import_module(name)
+        except Exception:  # noqa: BLE001 - numba's own import reports it
+            pass
+        finally:
+            sys.modules["warnings"] = _warnings

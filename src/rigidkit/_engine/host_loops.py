@@ -27,6 +27,7 @@ a writable one, ``"rN:uint8"`` / ``"wN:int64"`` of another NumPy dtype,
 
 from __future__ import annotations
 
+from . import compile_warnings
 from .loop_source import fold_source, scan_source
 from .numba_backend import idle_workers, import_source, run_split
 
@@ -75,6 +76,7 @@ def compile_host_loop(fn, args, dtypes=("float64", "float32"), *, returns=(), no
         if returns:
             res = types.Tuple(_types(returns, np.dtype(d)))
         sigs.append(res(*_types(args, np.dtype(d))))
+    compile_warnings.before_compile()  # numba may compile: its imports isolated
     return numba.njit(sigs, cache=True, nogil=nogil, error_model="numpy")(fn)
 
 
@@ -99,6 +101,7 @@ def compile_scan(chain, dtype):
         f"<rigidkit scan {chain.name}>",
     )
     sig = types.void(types.int64, *_types(("r2", "r3", "w3"), dtype))
+    compile_warnings.before_compile()  # numba may compile: its imports isolated
     return numba.njit([sig], cache=cache, nogil=True, error_model="numpy")(module.scan)
 
 
@@ -121,4 +124,5 @@ def compile_fold(step, carried, summed, inputs, dtype):
     )
     codes = ("r2",) + ("r3",) * len(inputs) + ("w2",)
     sig = types.void(*_types(codes, dtype))
+    compile_warnings.before_compile()  # numba may compile: its imports isolated
     return numba.njit([sig], cache=cache, nogil=True, error_model="numpy")(module.fold)

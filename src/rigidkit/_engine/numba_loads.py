@@ -42,6 +42,8 @@ def jit_signatures(fn, sigs, cache, **options):
     """
     import numba
 
+    from . import compile_warnings
+
     disp = numba.njit(cache=cache, **options)(fn)
     from numba.core import typeinfer
 
@@ -49,6 +51,7 @@ def jit_signatures(fn, sigs, cache, **options):
     with typeinfer.register_dispatcher(disp):
         for sig in sigs:
             if not (direct and _load_cached(disp, sig)):
+                compile_warnings.before_compile()
                 disp.compile(sig)
     disp.disable_compile()
     return disp
