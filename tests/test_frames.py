@@ -599,3 +599,52 @@ def test_readme_frames_example():
     want = np.linalg.solve(map_T_camera(now), then @ p)[:3]
     np.testing.assert_allclose(ns["p_camera_now"], want, atol=1e-9)
     assert ns["camera_track"].shape == (1000, 3)
+
+
+def _chain_graph(a, b):
+    graph = rk.FrameGraph()
+    graph.add("world", "base", rk.Transform.exp(a))
+    graph.add("base", "camera", rk.Transform.exp(b))
+    return graph
+
+
+def test_torch_gradient_of_a_lookup_equals_finite_differences(torch):
+    """A static path of torch poses stays on autograd's graph: the gradient of a
+    weighted sum of camera_T_world's matrix equals central differences of the
+    NumPy lookup (step 1e-6)."""
+    rng = np.random.default_rng(4)
+    a, b, W = rng.uniform(-1, 1, 6), rng.uniform(-1, 1, 6), rng.standard_normal((4, 4))
+
+    def loss_np(x):
+        return float((_chain_graph(x, b).get("camera", "world").as_matrix() * W).sum())
+
+    x = torch.tensor(a, requires_grad=True)
+    M = _chain_graph(x, torch.tensor(b)).get("camera", "world").as_matrix()
+    assert isinstance(M, torch.Tensor)
+    (got,) = torch.autograd.grad((M * torch.tensor(W)).sum(), x)
+    fd = np.array(
+        [(loss_np(a + 1e-6 * e) - loss_np(a - 1e-6 * e)) / 2e-6 for e in np.eye(6)]
+    )
+    np.testing.assert_allclose(got.numpy(), fd, rtol=1e-6, atol=1e-8)
+
+
+def test_jax_graph_built_under_jit_equals_numpy(jax):
+    """A graph built inside a jitted function: the lookup traces, and equals the
+    explicit composition exp(a) exp(b) of NumPy."""
+    rng = np.random.default_rng(5)
+    a, b = rng.uniform(-1, 1, 6), rng.uniform(-1, 1, 6)
+    f = jax.jit(lambda x, y: _chain_graph(x, y).get("world", "camera").as_matrix())
+    want = (rk.Transform.exp(a) @ rk.Transform.exp(b)).as_matrix()
+    np.testing.assert_allclose(np.asarray(f(a, b)), want, rtol=0, atol=1e-13)
+
+
+def test_a_batch_of_static_edges_broadcasts_like_one_pose_each():
+    """A batch of poses without stamps is a batch of static edges: the lookup
+    equals the lookups of graphs of one pose each."""
+    rng = np.random.default_rng(6)
+    a, b = rng.uniform(-1, 1, (3, 6)), rng.uniform(-1, 1, 6)
+    got = _chain_graph(a, b).get("camera", "world").as_matrix()
+    assert got.shape == (3, 4, 4)
+    for k in range(3):
+        want = _chain_graph(a[k], b).get("camera", "world").as_matrix()
+        np.testing.assert_allclose(got[k], want, rtol=0, atol=1e-14)

@@ -19,26 +19,6 @@ COMPILE_CI = {
 COMPILE_CHECKED: set = set()
 
 FAILS = {
-    ("rk.FrameGraph.__init__", "jit"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[7] at "
-        "applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.add", "jit"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[7] at "
-        "applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.get", "jit"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[7] at "
-        "applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.update_static", "jit"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[7] at "
-        "applications/frames/buffer.py:as_samples"
-    ),
     ("rk.FrameGraph.velocity", "jit"): (
         "TracerArrayConversionError: The numpy.ndarray conversion method "
         "__array__() was called on traced array with shape float64[4,7] at "
@@ -53,26 +33,6 @@ FAILS = {
         "ConcretizationTypeError: Abstract tracer value encountered where "
         "concrete value is expected: traced array with shape float64[] at "
         "functional/splines.py:rotation_spline_coefficients"
-    ),
-    ("rk.FrameGraph.__init__", "vmap"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[7] at "
-        "applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.add", "vmap"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[7] at "
-        "applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.get", "vmap"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[7] at "
-        "applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.update_static", "vmap"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[7] at "
-        "applications/frames/buffer.py:as_samples"
     ),
     ("rk.FrameGraph.velocity", "vmap"): (
         "TracerArrayConversionError: The numpy.ndarray conversion method "
@@ -89,26 +49,6 @@ FAILS = {
         "concrete value is expected: traced array with shape float64[] at "
         "functional/splines.py:rotation_spline_coefficients"
     ),
-    ("rk.FrameGraph.__init__", "grad"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[7] at "
-        "applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.add", "grad"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[7] at "
-        "applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.get", "grad"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[7] at "
-        "applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.update_static", "grad"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[7] at "
-        "applications/frames/buffer.py:as_samples"
-    ),
     ("rk.FrameGraph.velocity", "grad"): (
         "TracerArrayConversionError: The numpy.ndarray conversion method "
         "__array__() was called on traced array with shape float64[4,7] at "
@@ -124,46 +64,10 @@ FAILS = {
         "concrete value is expected: traced array with shape float64[] at "
         "functional/splines.py:rotation_spline_coefficients"
     ),
-    ("rk.FrameGraph.__init__", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead. at "
-        "applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.add", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead. at "
-        "applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.get", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead. at "
-        "applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.update_static", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead. at "
-        "applications/frames/buffer.py:as_samples"
-    ),
     ("rk.FrameGraph.velocity", "torch_grad"): (
         "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
         "tensor.detach().numpy() instead. at "
         "applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.__init__", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
-        "storage at applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.add", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
-        "storage at applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.get", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
-        "storage at applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.update_static", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
-        "storage at applications/frames/buffer.py:as_samples"
     ),
     ("rk.FrameGraph.velocity", "torch_vmap"): (
         "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
@@ -173,26 +77,6 @@ FAILS = {
         "RuntimeError: vmap: It looks like you're calling .item() on a Tensor. "
         "We don't support vmap over calling .item() on a Tensor, please try to "
         "rewrite what y at functional/splines.py:rotation_spline_coefficients"
-    ),
-    ("rk.FrameGraph.__init__", "dask"): (
-        "ShapeError: a static edge takes one pose, got a batch of shape (2,); "
-        "pass stamps= for a dynamic edge at "
-        "applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.add", "dask"): (
-        "ShapeError: a static edge takes one pose, got a batch of shape (2,); "
-        "pass stamps= for a dynamic edge at "
-        "applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.get", "dask"): (
-        "ShapeError: a static edge takes one pose, got a batch of shape (2,); "
-        "pass stamps= for a dynamic edge at "
-        "applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.update_static", "dask"): (
-        "ShapeError: a static edge takes one pose, got a batch of shape (2,); "
-        "pass stamps= for a dynamic edge at "
-        "applications/frames/buffer.py:as_samples"
     ),
     ("rk.FrameGraph.velocity", "dask"): (
         "AssertionError: the call computed the graph 1 time(s)"

@@ -257,6 +257,8 @@ def shaped(T, shape):
         if shape:  # an all-static path asked at many times: the one pose, broadcast
             return wrap_pq(np.broadcast_to(registry.stored(T), shape + (7,)).copy())
         return T
+    if not shape:  # one time: a batch of static edges' batch shape, as it is
+        return T
     return T.reshape(shape) if shape != T.shape else T
 
 
