@@ -15,12 +15,9 @@ import numpy as np
 from .._validate import as_array, to_numpy
 from ..functional import averaging as _avg
 from ..functional import conversions as _conv
-from ..functional import davenport as _dav
 from ..functional import distances as _dist
-from ..functional import euler
 from ..functional import interpolation as _interp
 from ..functional import quaternion as _quaternion
-from ..functional import rot6d as _r6
 from ..functional import sequences as _seq
 from ..functional import so3 as _so3
 from ..functional import swing_twist as _st
@@ -28,13 +25,14 @@ from ..functional import symmetry as _sym
 from ..kernels.kinematics import integration as _ki
 from ._batch import BatchedArray, batch_shape, expect
 from ._frozen import frozen
+from ._rotation_angles import RotationAngles
 from .group import LieGroup
 from .registry import GroupSpec
 
 __all__ = ["Rotation", "geodesic_distance", "chordal_distance"]
 
 
-class Rotation(BatchedArray, LieGroup, family="space", rank=0):
+class Rotation(RotationAngles, BatchedArray, LieGroup, family="space", rank=0):
     """A batch of 3D rotations of any shape, one unit quaternion each.
 
     Conventions: Hamilton quaternions ``(w, x, y, z)``; active rotations on column
@@ -143,63 +141,6 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
         return cls._wrap(_conv.quat_from_axis_angle(axis, t))
 
     @classmethod
-    def from_mrp(cls, mrp):
-        """From modified Rodrigues parameters ``axis * tan(angle / 4)``, shape (..., 3)."""
-        return cls._wrap(_conv.quat_from_mrp(mrp))
-
-    @classmethod
-    def from_euler(cls, seq, angles, *, degrees=False):
-        """From Euler angles, shape (..., n) for a sequence of ``n`` letters.
-
-        ``seq``: three letters of ``xyz``, or one or two as in scipy (``"z"``,
-        ``"zy"``; with one letter a scalar angle is accepted); UPPERCASE =
-        intrinsic (body axes), lowercase = extrinsic (world axes). ``"ZYX"`` is
-        yaw-pitch-roll. :meth:`as_euler` takes three letters (as scipy's).
-
-        >>> R = Rotation.from_euler("ZYX", [90.0, 0.0, 0.0], degrees=True)
-        >>> np.round(R.as_rotvec(), 12) + 0.0
-        array([0.        , 0.        , 1.57079633])
-        >>> bool(R.approx_equal(Rotation.from_euler("z", 90.0, degrees=True)))
-        True
-        """
-        return cls._wrap(euler.quat_from_euler(seq, angles, degrees=degrees))
-
-    @classmethod
-    def from_davenport(cls, axes, order, angles, *, degrees=False):
-        """From Davenport angles: turns about 1 to 3 given axes (scipy's semantics).
-
-        ``order="intrinsic"`` (``"i"``, body axes): ``R = R_n1(t1) R_n2(t2)
-        R_n3(t3)``; ``"extrinsic"`` (``"e"``, world axes): ``R = R_n3(t3) R_n2(t2)
-        R_n1(t1)``. ``axes`` (3,) or (..., n, 3), any nonzero length, consecutive
-        ones orthogonal (``n1`` and ``n3`` may make any angle); ``angles`` (..., n),
-        a scalar for one axis. See
-        :func:`rigidkit.functional.davenport.quat_from_davenport`.
-
-        >>> ez, ey, ex = [0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]
-        >>> angles = [30.0, 20.0, 10.0]
-        >>> R = Rotation.from_davenport([ez, ey, ex], "intrinsic", angles, degrees=True)
-        >>> bool(R.approx_equal(Rotation.from_euler("ZYX", angles, degrees=True)))
-        True
-        """
-        return cls._wrap(_dav.quat_from_davenport(axes, order, angles, degrees=degrees))
-
-    def as_davenport(self, axes, order, *, degrees=False):
-        """Davenport angles about three axes (..., 3, 3), shape (..., 3).
-
-        Conventions and ranges as :meth:`from_davenport` and
-        :func:`rigidkit.functional.davenport.davenport_from_quat` (scipy's): the
-        middle angle lies in an interval of length pi that starts at the angle
-        between the first and last axis; at gimbal lock a
-        :class:`~rigidkit.GimbalLockWarning` and the third angle 0.
-
-        >>> axes = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 1.0]]
-        >>> R = Rotation.from_davenport(axes, "e", [0.4, -0.3, 0.2])
-        >>> np.round(R.as_davenport(axes, "e"), 12) + 0.0
-        array([ 0.4, -0.3,  0.2])
-        """
-        return _dav.davenport_from_quat_unchecked(axes, order, self._quat, degrees=degrees)
-
-    @classmethod
     def create_group(cls, group, axis="Z", *, dtype=None):
         """The elements of a finite rotation group, shape (n,) (scipy's ``create_group``).
 
@@ -241,22 +182,6 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
         if not return_indices:
             return reduced
         return reduced, (None if left is None else li), (None if right is None else ri)
-
-    @classmethod
-    def from_6d(cls, rot6d):
-        """From the continuous 6D representation (Zhou et al. 2019), shape (..., 6).
-
-        The first two COLUMNS ``a1, a2`` of the matrix, ``(R00, R10, R20, R01, R11,
-        R21)``, any scale: ``R = [b1 b2 b1 x b2]`` by Gram-Schmidt. (pytorch3d's
-        ``rotation_6d`` holds the first two rows: that is ``R.inv().as_6d()``.)
-        Zero or parallel vectors raise :class:`~rigidkit.DegenerateInputError`.
-        See :mod:`rigidkit.functional.rot6d`.
-
-        >>> R = Rotation.from_6d([2.0, 0.0, 0.0, 1.0, 3.0, 0.0])
-        >>> np.round(R.as_quat(), 12) + 0.0
-        array([1., 0., 0., 0.])
-        """
-        return cls._wrap(_r6.quat_from_rot6d(rot6d))
 
     @classmethod
     def random(cls, shape=(), rng=None, *, dtype=None):
@@ -308,32 +233,6 @@ class Rotation(BatchedArray, LieGroup, family="space", rank=0):
         """
         axis, angle = _conv.axis_angle_from_quat_unchecked(self._quat)
         return axis, (angle * (180.0 / math.pi) if degrees else angle)
-
-    def as_6d(self):
-        """The 6D representation: the first two matrix columns, shape (..., 6).
-
-        ``(R00, R10, R20, R01, R11, R21)`` (Zhou et al. 2019); see :meth:`from_6d`.
-
-        >>> np.round(Rotation.from_rotvec([0.0, 0.0, np.pi / 2]).as_6d(), 12) + 0.0
-        array([ 0.,  1.,  0., -1.,  0.,  0.])
-        """
-        return _r6.rot6d_from_quat(self._quat)
-
-    def as_mrp(self):
-        """Modified Rodrigues parameters ``axis * tan(angle / 4)``, norm <= 1."""
-        return _conv.mrp_from_quat_unchecked(self._quat)
-
-    def as_euler(self, seq, *, degrees=False):
-        """Euler angles for ``seq`` (UPPER intrinsic, lower extrinsic), shape (..., 3).
-
-        First and third angles in (-pi, pi]; the second in [0, pi] for proper
-        sequences (``ZXZ``) and [-pi/2, pi/2] for Tait-Bryan ones (``ZYX``). At gimbal
-        lock a :class:`~rigidkit.GimbalLockWarning` is emitted and the third angle
-        is 0, also at a lock missed by rounding only (angles like ``(30, 90, 10)``
-        degrees: see :func:`rigidkit.euler.euler_from_quat`); the angles always
-        rebuild the rotation.
-        """
-        return euler.euler_from_quat_unchecked(seq, self._quat, degrees=degrees)
 
     @property
     def angle(self):
