@@ -24,45 +24,15 @@ FAILS = {
         "__array__() was called on traced array with shape float64[4,7] at "
         "applications/frames/buffer.py:as_samples"
     ),
-    ("rk.RotationSpline.__call__", "jit"): (
-        "ConcretizationTypeError: Abstract tracer value encountered where "
-        "concrete value is expected: traced array with shape float64[] at "
-        "functional/splines.py:rotation_spline_coefficients"
-    ),
-    ("rk.RotationSpline.__init__", "jit"): (
-        "ConcretizationTypeError: Abstract tracer value encountered where "
-        "concrete value is expected: traced array with shape float64[] at "
-        "functional/splines.py:rotation_spline_coefficients"
-    ),
     ("rk.FrameGraph.velocity", "vmap"): (
         "TracerArrayConversionError: The numpy.ndarray conversion method "
         "__array__() was called on traced array with shape float64[4,7] at "
         "applications/frames/buffer.py:as_samples"
     ),
-    ("rk.RotationSpline.__call__", "vmap"): (
-        "ConcretizationTypeError: Abstract tracer value encountered where "
-        "concrete value is expected: traced array with shape float64[] at "
-        "functional/splines.py:rotation_spline_coefficients"
-    ),
-    ("rk.RotationSpline.__init__", "vmap"): (
-        "ConcretizationTypeError: Abstract tracer value encountered where "
-        "concrete value is expected: traced array with shape float64[] at "
-        "functional/splines.py:rotation_spline_coefficients"
-    ),
     ("rk.FrameGraph.velocity", "grad"): (
         "TracerArrayConversionError: The numpy.ndarray conversion method "
         "__array__() was called on traced array with shape float64[4,7] at "
         "applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.RotationSpline.__call__", "grad"): (
-        "ConcretizationTypeError: Abstract tracer value encountered where "
-        "concrete value is expected: traced array with shape float64[] at "
-        "functional/splines.py:rotation_spline_coefficients"
-    ),
-    ("rk.RotationSpline.__init__", "grad"): (
-        "ConcretizationTypeError: Abstract tracer value encountered where "
-        "concrete value is expected: traced array with shape float64[] at "
-        "functional/splines.py:rotation_spline_coefficients"
     ),
     ("rk.FrameGraph.velocity", "torch_grad"): (
         "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
@@ -72,11 +42,6 @@ FAILS = {
     ("rk.FrameGraph.velocity", "torch_vmap"): (
         "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
         "storage at applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.RotationSpline.__init__", "torch_vmap"): (
-        "RuntimeError: vmap: It looks like you're calling .item() on a Tensor. "
-        "We don't support vmap over calling .item() on a Tensor, please try to "
-        "rewrite what y at functional/splines.py:rotation_spline_coefficients"
     ),
     ("rk.FrameGraph.velocity", "dask"): (
         "AssertionError: the call computed the graph 1 time(s)"

@@ -5,9 +5,12 @@ Quaternions are Hamilton, scalar first; poses ``(w, x, y, z, tx, ty, tz)``; twis
 ``(v, w)``. Rates are body-frame here (``R^T dR/dt``, ``T^-1 dT/dt``); the object
 layer maps them to the world frame. Keyframes and control points carry the time
 (knot) axis first, then any batch axes, so one call builds many splines that
-share their times. Written against the array API (namespace of the input);
-knot lookup and the convergence test of the spline solve read concrete values
-(NumPy-side), so these functions do not trace under ``jax.jit``. Dask keyframes
+share their times. Written against the array API (namespace of the input). The
+knot times are NumPy (concrete: they select the segment of each query); the
+keyframes, control points and query times may be traced (``jax.jit``, ``vmap``,
+``grad``, ``torch.func``): the Newton solve of the rotation spline then runs a
+fixed number of steps, each frozen (``where``) once the eager convergence test
+is met (:func:`rotation_spline_coefficients`). Dask keyframes
 stay lazy: the spline solve couples all keyframes, so the time axis is made whole
 (one chunk) and each chunk of the further batch axes is solved on its own
 (:func:`rotation_spline_coefficients`); evaluation gathers segments lazily.
@@ -40,7 +43,7 @@ import numpy as np
 
 from .._engine import dask_backend
 from .._engine.namespace import device_of, namespace_of
-from .._validate import tolerances
+from .._validate import concrete, tolerances
 from ..errors import ConvergenceWarning
 from ..kernels import quaternion as _kq
 from ..kernels import se3 as _kse3
@@ -123,7 +126,9 @@ def rotation_spline_coefficients(times, quats, *, max_iter=50):
     coeffs : array, shape (n - 1, ..., 3, 3)
         ``(a, b, c)`` of each segment, ``r(s) = a s^3 + b s^2 + c s``.
     iterations : int
-        Newton steps taken (0 for two keyframes).
+        Newton steps taken (0 for two keyframes); a 0-d integer array where the
+        keyframes are traced (:func:`_newton_traced`: ``max_iter`` steps, the
+        rates frozen once converged).
 
     Notes
     -----
@@ -156,44 +161,13 @@ def rotation_spline_coefficients(times, quats, *, max_iter=50):
         beta = 6.0 * (theta[:-1] / (h0 * h0) + theta[1:] / (h1 * h1))
         w = xp.stack(omega[1:-1], axis=0)
         first, last = omega[0], omega[-1]
-        scale = float(xp.max(xp.abs(rates)))
+
+        params = (theta[:-1], jr_inv[:-1], lower, center, upper, beta, first, last)
         done = tolerances(theta.dtype).newton_rtol
-        prev = math.inf
-        for iterations in range(1, max_iter + 1):  # noqa: B007 (the count is returned)
-            full = xp.concat([first[None], w, last[None]], axis=0)
-            rdot = _matvec(jr_inv[:-1], full[1:-1])  # r'(h) at the end of segment k-1
-            base = _nonlinear(theta[:-1], rdot)
-            res = (
-                _matvec(lower, full[:-2])
-                + _matvec(center, full[1:-1])
-                + _matvec(upper, full[2:])
-                + base
-                - beta
-            )
-            # N(theta, r') is quadratic in r', so its derivative along e is exactly
-            # (N(r' + s e) - N(r') - N(s e)) / s: a polarisation, not a difference.
-            s = 1.0 + xp.max(xp.abs(rdot))
-            cols = []
-            for k in range(3):
-                e = _const(xp, np.eye(3)[k], theta) * s
-                dn = _nonlinear(theta[:-1], rdot + e) - base - _nonlinear(theta[:-1], e)
-                cols.append(dn / s)
-            g = xp.stack(cols, axis=-1) @ jr_inv[:-1]
-            step = _solve_block_tridiagonal(xp, lower, center + g, upper, res)
-            w = w - step
-            size = float(xp.max(xp.abs(step)))
-            ref = max(float(xp.max(xp.abs(w))), scale, 1e-300)
-            # Done at rounding level, or when Newton stops contracting there.
-            if size <= done * ref or (size > 0.5 * prev and size < 1e-8 * ref):
-                break
-            prev = size
-        else:
-            warnings.warn(
-                f"the rotation spline solve did not converge in {max_iter} Newton steps "
-                f"(last step {size:.3g}); the spline is C2 only to that level",
-                ConvergenceWarning,
-                stacklevel=3,
-            )
+        if concrete(theta):
+            w, iterations = _newton_eager(xp, params, w, rates, done, max_iter)
+        else:  # traced (jit, vmap, grad, torch.compile, torch.func)
+            w, iterations = _newton_traced(xp, params, w, rates, done, max_iter)
         omega = [first] + [w[e] for e in range(m)] + [last]
     full = xp.stack(omega, axis=0)
     c = full[:-1]
@@ -203,6 +177,106 @@ def rotation_spline_coefficients(times, quats, *, max_iter=50):
     a = (-2.0 * theta + h * c + h * d) / (h * h * h)
     b = (3.0 * theta - 2.0 * h * c - h * d) / (h * h)
     return xp.stack([a, b, c], axis=-2), iterations
+
+
+def _newton_step(xp, params, w):
+    """One Newton step of the spline equations on the interior rates ``w``:
+    ``(w - step, step)``; ``params`` are the equations' fixed parts."""
+    theta, jr_inv, lower, center, upper, beta, first, last = params
+    full = xp.concat([first[None], w, last[None]], axis=0)
+    rdot = _matvec(jr_inv, full[1:-1])  # r'(h) at the end of segment k-1
+    base = _nonlinear(theta, rdot)
+    res = (
+        _matvec(lower, full[:-2])
+        + _matvec(center, full[1:-1])
+        + _matvec(upper, full[2:])
+        + base
+        - beta
+    )
+    # N(theta, r') is quadratic in r', so its derivative along e is exactly
+    # (N(r' + s e) - N(r') - N(s e)) / s: a polarisation, not a difference.
+    s = 1.0 + xp.max(xp.abs(rdot))
+    cols = []
+    for k in range(3):
+        e = _const(xp, np.eye(3)[k], theta) * s
+        dn = _nonlinear(theta, rdot + e) - base - _nonlinear(theta, e)
+        cols.append(dn / s)
+    g = xp.stack(cols, axis=-1) @ jr_inv
+    step = _solve_block_tridiagonal(xp, lower, center + g, upper, res)
+    return w - step, step
+
+
+def _newton_eager(xp, params, w, rates, done, max_iter):
+    """Newton steps until one changes no rate by more than ``done`` times the
+    largest rate, or stops contracting at rounding level; ``(w, steps taken)``."""
+    scale = float(xp.max(xp.abs(rates)))
+    prev = math.inf
+    for iterations in range(1, max_iter + 1):  # noqa: B007 (the count is returned)
+        w, step = _newton_step(xp, params, w)
+        size = float(xp.max(xp.abs(step)))
+        ref = max(float(xp.max(xp.abs(w))), scale, 1e-300)
+        # Done at rounding level, or when Newton stops contracting there.
+        if size <= done * ref or (size > 0.5 * prev and size < 1e-8 * ref):
+            return w, iterations
+        prev = size
+    warnings.warn(
+        f"the rotation spline solve did not converge in {max_iter} Newton steps "
+        f"(last step {size:.3g}); the spline is C2 only to that level",
+        ConvergenceWarning,
+        stacklevel=4,
+    )
+    return w, max_iter
+
+
+def _newton_traced(xp, params, w, rates, done, max_iter):
+    """:func:`_newton_eager` without reading values; ``iterations`` is then a 0-d
+    array. No warning is given for a solve that did not converge (its values
+    cannot be read).
+
+    On JAX one ``lax.while_loop`` to the eager test (per spline under ``vmap``),
+    on values cut from the gradient (``stop_gradient``), then one more Newton step
+    on the live equations: at the solution that step's derivative is the
+    implicit one, ``-F_w^-1 dF`` (the implicit function theorem; Newton's step
+    at a root), so ``grad`` needs no differentiation of the loop. Elsewhere
+    (torch.func, torch.compile) ``max_iter`` steps unrolled, each spline's rates
+    frozen (``where``) from the step that meets the eager test on.
+    """
+    zero = 0.0 * xp.max(xp.abs(rates))
+    state = (w, zero != zero, zero + math.inf, zero)  # not stopped (NaN aside)
+    if type(w).__module__.startswith("jax"):
+        import jax
+
+        cut = jax.tree_util.tree_map(jax.lax.stop_gradient, (params, w, rates))
+        fixed, w0, scale = cut[0], cut[1], xp.max(xp.abs(cut[2]))
+
+        def go(state):
+            return ~state[1] & (state[3] < max_iter)
+
+        def step(state):
+            return _newton_update(xp, fixed, done, scale, state, freeze=False)
+
+        w, _, _, count = jax.lax.while_loop(go, step, (w0,) + state[1:])
+        w = _newton_step(xp, params, jax.lax.stop_gradient(w))[0]
+        return w, count
+    scale = xp.max(xp.abs(rates))
+    for _ in range(max_iter):
+        state = _newton_update(xp, params, done, scale, state, freeze=True)
+    return state[0], state[3]
+
+
+def _newton_update(xp, params, done, scale, state, freeze):
+    """One step of :func:`_newton_traced`: ``(w, stopped, last size, steps)``."""
+    w, stop, prev, count = state
+    new, step = _newton_step(xp, params, w)
+    size = xp.max(xp.abs(step))
+    ref = xp.maximum(xp.maximum(xp.max(xp.abs(new)), scale), 1e-300 + 0.0 * scale)
+    met = (size <= done * ref) | ((size > 0.5 * prev) & (size < 1e-8 * ref))
+    if not freeze:
+        return new, met, size, count + 1.0
+    w = xp.where(stop, w, new)
+    count = xp.where(stop, count, count + 1.0)
+    prev = xp.where(stop, prev, size)
+    return w, stop | met, prev, count
 
 
 def _lazy_coefficients(times, quats, max_iter):
