@@ -648,3 +648,40 @@ def test_a_batch_of_static_edges_broadcasts_like_one_pose_each():
     for k in range(3):
         want = _chain_graph(a[k], b).get("camera", "world").as_matrix()
         np.testing.assert_allclose(got[k], want, rtol=0, atol=1e-14)
+
+
+@pytest.mark.parametrize("interpolation", ["decoupled", "screw"])
+def test_torch_gradient_through_a_dynamic_edge_equals_finite_differences(
+    torch, interpolation
+):
+    """Stamped torch poses stay on autograd's graph through the interpolation: the
+    gradients of a pose lookup and of a velocity (at a time between samples, and
+    at a batch of times) equal central differences of the NumPy calls."""
+    rng = np.random.default_rng(7)
+    X = rng.uniform(-0.5, 0.5, (4, 6))
+    stamps = np.arange(4) * 0.5
+    at = np.array([0.7, 1.3])
+
+    def outputs(x):
+        graph = rk.FrameGraph()
+        graph.add("world", "body", rk.Transform.exp(x), stamps=stamps)
+        return [
+            graph.get("body", "world", 0.7, interpolation=interpolation).as_matrix(),
+            graph.get("world", "body", at, interpolation=interpolation).as_matrix(),
+            graph.velocity("world", "body", at, frame="world", interpolation=interpolation),
+        ]
+
+    weights = [rng.standard_normal(np.shape(o)) for o in outputs(X)]
+
+    def loss_np(x):
+        return sum(float((np.asarray(o) * w).sum()) for o, w in zip(outputs(x), weights))
+
+    x = torch.tensor(X, requires_grad=True)
+    loss = sum((o * torch.tensor(w)).sum() for o, w in zip(outputs(x), weights))
+    (got,) = torch.autograd.grad(loss, x)
+    fd = np.zeros_like(X)
+    for j in np.ndindex(X.shape):
+        e = np.zeros_like(X)
+        e[j] = 1e-6
+        fd[j] = (loss_np(X + e) - loss_np(X - e)) / 2e-6
+    np.testing.assert_allclose(got.numpy(), fd, rtol=1e-6, atol=1e-7)

@@ -19,33 +19,6 @@ COMPILE_CI = {
 COMPILE_CHECKED: set = set()
 
 FAILS = {
-    ("rk.FrameGraph.velocity", "jit"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[4,7] at "
-        "applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.velocity", "vmap"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[4,7] at "
-        "applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.velocity", "grad"): (
-        "TracerArrayConversionError: The numpy.ndarray conversion method "
-        "__array__() was called on traced array with shape float64[4,7] at "
-        "applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.velocity", "torch_grad"): (
-        "RuntimeError: Can't call numpy() on Tensor that requires grad. Use "
-        "tensor.detach().numpy() instead. at "
-        "applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.velocity", "torch_vmap"): (
-        "RuntimeError: Cannot access data pointer of Tensor that doesn't have "
-        "storage at applications/frames/buffer.py:as_samples"
-    ),
-    ("rk.FrameGraph.velocity", "dask"): (
-        "AssertionError: the call computed the graph 1 time(s)"
-    ),
     ("rk.Transform.__matmul__", "compile"): (
         "Unsupported: Failed to trace builtin operator (torch.compile fullgraph)"
     ),

@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..._engine import dask_backend
+from ..._engine.namespace import namespace_of
 from ...errors import ExtrapolationError, ShapeError, TimestampError
 from ...kernels.geodesic import pose_from_quat_lerp as _pose_from_quat_lerp
 from ...kernels.geodesic import pose_slerp as _slerp_screw
@@ -74,11 +76,12 @@ def as_samples(parent_T_child, stamps, cov):
         if cov is not None:
             cov = _checked_cov(np.array(cov, dtype=np.float64), 1)
         return None, pq.reshape((1,) + tuple(pq.shape)), cov
-    # A dynamic edge's samples are NumPy (its buffer is written in place); a
-    # torch tensor that requires grad is refused here rather than detached.
-    pq = np.asarray(pq, dtype=np.float64)
+    # A dynamic edge's stamps are NumPy (searched on the host); its poses stay in
+    # their namespace (torch, JAX, Dask), NumPy ones in a buffer written in place.
+    if not _foreign(pq):
+        pq = np.asarray(pq, dtype=np.float64)
     t = np.array(stamps, dtype=np.float64, ndmin=1)
-    pq = pq.reshape(-1, 7)
+    pq = pq.reshape((-1, 7))
     if t.ndim != 1 or t.shape[0] != pq.shape[0]:
         raise ShapeError(
             f"stamps of shape {np.shape(stamps)} for {pq.shape[0]} poses; "
@@ -90,7 +93,7 @@ def as_samples(parent_T_child, stamps, cov):
         raise TimestampError(f"stamps[{i}] is {float(t[i])!r}, not finite", index=(i,))
     if cov is not None:
         cov = _checked_cov(np.array(cov, dtype=np.float64), pq.shape[0])
-    return t, np.ascontiguousarray(pq), cov
+    return t, (pq if _foreign(pq) else np.ascontiguousarray(pq)), cov
 
 
 def _checked_cov(cov, m):
@@ -259,7 +262,7 @@ class Snapshot:
             if want_cov and self.cov is not None:
                 cov = np.broadcast_to(self.cov[0], q.shape + (6, 6)).copy()
             return T, cov
-        if 4 * many >= pq.shape[0]:
+        if 4 * many >= pq.shape[0] and not _foreign(pq):
             T = self._from_increments(i, a, interpolation)
         else:
             T = slerp(
@@ -349,20 +352,21 @@ class Snapshot:
         (the rotation part is the body angular velocity of the slerp). Zero for
         a static edge or a single sample.
         """
-        out = np.zeros(q.shape + (6,))
         if self.t is None or self.t.shape[0] == 1:
-            return out
+            return np.zeros(q.shape + (6,))
         i, _ = self.locate(q)
         dt = (self.t[i + 1] - self.t[i])[:, None]
+        if _foreign(self.pq) and not dask_backend.is_dask(self.pq):
+            dt = namespace_of(self.pq).asarray(dt)  # torch, JAX: in their namespace
         T0, T1 = wrap_pq(self.pq[i]), wrap_pq(self.pq[i + 1])
         if interpolation == "screw":
-            return np.asarray((T0.inv() @ T1).log()) / dt
+            return (T0.inv() @ T1).log() / dt
         omega = (T0.rotation.inv() @ T1.rotation).as_rotvec() / dt
         T, _ = self.at(q, interpolation)
         v = T.rotation.inv().apply((self.pq[i + 1, 4:] - self.pq[i, 4:]) / dt)
-        out[:, :3] = v
-        out[:, 3:] = omega
-        return out
+        if _foreign(v):
+            return namespace_of(v).concat([v, omega], axis=-1)
+        return np.concatenate([v, omega], axis=-1)
 
 
 class EdgeBuffer:
@@ -389,7 +393,13 @@ class EdgeBuffer:
         self._t = None
         self._pq, self._cov = pq, cov
         self._lo, self._hi = 0, pq.shape[0]
-        if t is not None:
+        if t is not None and _foreign(pq):
+            # poses of another namespace: kept as one array, in stamp order
+            t, pq, cov = _merge(t[:0], pq[:0], None, t, pq, cov)
+            self._t, self._pq, self._cov = t, pq, cov
+            self._lo, self._hi = 0, t.shape[0]
+            self._trim()
+        elif t is not None:
             self._replace(*_merge(t[:0], pq[:0], None, t, pq, cov))
 
     @property
@@ -417,6 +427,11 @@ class EdgeBuffer:
     def insert(self, t, pq, cov):
         """Add samples (any order); a stamp already held is replaced by the new pose."""
         lo, hi = self._lo, self._hi
+        if _foreign(pq) or _foreign(self._pq):
+            raise ValueError(
+                f"edge {self.parent!r} -> {self.child!r}: samples of torch, JAX or "
+                "Dask poses are given at once (add them with all their stamps)"
+            )
         if (
             t.shape[0] == 1
             and t[0] > self._t[hi - 1]
@@ -480,6 +495,8 @@ def _merge(t0, pq0, cov0, t1, pq1, cov1):
     keep = np.ones(ts.shape[0], dtype=bool)
     keep[:-1] = ts[1:] != ts[:-1]
     order = order[keep]
+    if t0.shape[0] == 0 and _foreign(pq1):  # a new edge of torch, JAX, Dask poses
+        return t[order], pq1[order], None if cov1 is None else cov1[order]
     pq = np.concatenate([pq0, pq1])[order]
     cov = None if cov0 is None else np.concatenate([cov0, cov1])[order]
     return t[order], pq, cov

@@ -105,6 +105,13 @@ class FrameGraph:
             Covariance of each pose, of a right perturbation ``T exp(xi)`` with
             ``xi = (v, omega)`` (the convention of :class:`UncertainTransform`).
 
+        Poses of torch, JAX or Dask stay in their namespace (autograd, tracing
+        with the graph built inside the traced function, lazy Dask); lookups and
+        :meth:`velocity` compose and interpolate them there, the stamps are
+        searched on the host (NumPy). Such a dynamic edge takes its samples in
+        one call. A batch of poses without stamps is a batch of static edges,
+        broadcast by the lookups.
+
         Raises
         ------
         ConnectivityError
@@ -448,7 +455,7 @@ class FrameGraph:
         q = np.reshape(q, -1)
         V, T = body_twist_path(up_s, up_t, q, interpolation, extrapolate)
         if frame == "world":
-            V = np.einsum("...ij,...j->...i", np.asarray(T.adjoint()), V)
+            V = (T.adjoint() @ V[..., None])[..., 0]  # any namespace
         return V.reshape(shape + (6,))
 
     # -- pictures and files ----------------------------------------------------------

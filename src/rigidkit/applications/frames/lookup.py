@@ -222,29 +222,31 @@ def body_twist_path(up_s, up_t, q, interpolation, extrapolate):
         factors.append((E.inv(), -_act(E.adjoint(), V)))
     for s in reversed(up_s):
         factors.append(_moving_edge(s, q, interpolation, extrapolate))
-    total = np.zeros(q.shape + (6,))
+    total = None
     tail = None  # E_{i+1} ... E_k, built from the right
     for E, V in reversed(factors):
         if tail is None:
-            total = total + V
+            total = V
             tail = E
         else:
             total = total + _act(tail.inv().adjoint(), V)
             tail = E @ tail
     if tail is None:
-        tail = Transform()
+        return np.zeros(q.shape + (6,)), Transform()
     return total, tail
 
 
 def _act(M, v):
     """``M @ v`` over a batch of matrices (M, 6, 6) and vectors (M, 6)."""
-    return np.einsum("...ij,...j->...i", np.asarray(M), v)
+    return (M @ v[..., None])[..., 0]  # any namespace (torch, JAX, Dask)
 
 
 def _moving_edge(s, q, interpolation, extrapolate):
     """An edge's pose at ``q`` as a batch (M,) and its body twist (M, 6)."""
     if s.t is None:
-        E = wrap_pq(np.broadcast_to(s.pq[0], q.shape + (7,)).copy())
+        E = s.pose
+        if E.single:
+            E = wrap_pq(np.broadcast_to(s.pq[0], q.shape + (7,)).copy())
         return E, np.zeros(q.shape + (6,))
     q = s.check(q, extrapolate)
     E, _ = s.at(q, interpolation)
