@@ -9,8 +9,11 @@ kinds (see :mod:`rigidkit.objects.ladder`): composing with a lower kind gives an
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
+from .._engine import dask_backend
 from .._engine.namespace import device_of, namespace_of
 from .._validate import (
     as_array,
@@ -27,7 +30,7 @@ from ._batch import BatchedArray, batch_shape
 from ._frozen import frozen
 from .group import Group
 from .ladder import homogeneous_matrix
-from .projective import Projective
+from .projective import Projective, _checked_per_chunk
 
 __all__ = ["Affine", "NotAffineError"]
 
@@ -79,9 +82,10 @@ class Affine(BatchedArray, Group, family="space", rank=3):
         )
         if A is None and t is None:
             A = np.eye(3)
-        if A is not None:
+        lazy = dask_backend.any_dask(A, t)  # checked per chunk at compute time, below
+        if A is not None and not lazy:
             check_finite(A, (3, 3), "affine matrix A")
-        if t is not None:
+        if t is not None and not lazy:
             check_finite(t, (3,), "translation")
         ref = A if A is not None else t
         xp = namespace_of(ref)
@@ -101,7 +105,10 @@ class Affine(BatchedArray, Group, family="space", rank=3):
             axis=-1,
         )
         tol = singular_rtol(data.dtype) if rtol is None else rtol
-        check_invertible(_k.affine_hadamard_ratio(data), tol, "affine matrix A")
+        if lazy:
+            data = _checked_per_chunk(data, functools.partial(_check_data, rtol=tol))
+        else:
+            check_invertible(_k.affine_hadamard_ratio(data), tol, "affine matrix A")
         self._data = data
 
     @classmethod
@@ -119,8 +126,10 @@ class Affine(BatchedArray, Group, family="space", rank=3):
             ``A`` is singular (see the class docs), naming the batch index.
         """
         M = as_float(as_array(matrix, (4, 4), "homogeneous matrix"))
-        check_finite(M, (4, 4), "homogeneous matrix")
-        check_bottom_row(M, atol, "an affine transform", NotAffineError)
+        if dask_backend.is_dask(M):
+            M = _checked_per_chunk(M, functools.partial(_check_homogeneous, atol=atol))
+        else:
+            _check_homogeneous(M, atol)
         return cls(matrix=M[..., :3, :3], translation=M[..., :3, 3], rtol=rtol)
 
     @classmethod
@@ -200,6 +209,19 @@ class Affine(BatchedArray, Group, family="space", rank=3):
         A = [row[:3] for row in d]
         t = [row[3] for row in d]
         return f"Affine(matrix={A!r}, translation={t!r})"
+
+
+def _check_data(data, rtol):
+    """The constructor's checks of ``[A | t]`` (..., 3, 4)."""
+    check_finite(data[..., :3], (3, 3), "affine matrix A")
+    check_finite(data[..., 3], (3,), "translation")
+    check_invertible(_k.affine_hadamard_ratio(data), rtol, "affine matrix A")
+
+
+def _check_homogeneous(M, atol):
+    """:meth:`Affine.from_matrix`'s checks of ``[[A, t], [0, 1]]`` (..., 4, 4)."""
+    check_finite(M, (4, 4), "homogeneous matrix")
+    check_bottom_row(M, atol, "an affine transform", NotAffineError)
 
 
 def _cast(xp, a, dtype):

@@ -9,10 +9,14 @@ a ``Projective``.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
+from .._engine import dask_backend
 from .._engine.namespace import device_of, namespace_of
 from .._validate import (
+    _relabel,
     any_true,
     as_array,
     as_float,
@@ -22,6 +26,7 @@ from .._validate import (
     raise_where,
     singular_rtol,
     to_numpy,
+    validation_enabled,
 )
 from ..errors import PointAtInfinityError, SingularMatrixError
 from ..kernels import homogeneous as _k
@@ -76,9 +81,11 @@ class Projective(BatchedArray, Group, family="space", rank=4):
 
     def __init__(self, matrix, *, rtol=None):
         H = as_float(as_array(matrix, (4, 4), "projective matrix"))
-        check_finite(H, (4, 4), "projective matrix")
         tol = singular_rtol(H.dtype) if rtol is None else rtol
-        check_invertible(_k.projective_hadamard_ratio(H), tol, "projective matrix")
+        if dask_backend.is_dask(H):  # checked per chunk at compute time
+            self._data = _checked_per_chunk(H, functools.partial(_check_matrix, rtol=tol))
+            return
+        _check_matrix(H, tol)
         self._data = owned(H, matrix)  # not the caller's array: objects are immutable
 
     @classmethod
@@ -177,3 +184,30 @@ class Projective(BatchedArray, Group, family="space", rank=4):
     # -- container protocol (shape, len, [], reshape, ...): BatchedArray ------------------
     def _repr_single(self):
         return f"Projective({to_numpy(self._data).tolist()!r})"
+
+
+def _check_matrix(H, rtol):
+    """The constructor's checks of ``H`` (..., 4, 4): finite, invertible."""
+    check_finite(H, (4, 4), "projective matrix")
+    check_invertible(_k.projective_hadamard_ratio(H), rtol, "projective matrix")
+
+
+def _passed(check, block):
+    check(block)
+    return block
+
+
+def _checked_per_chunk(x, check):
+    """The Dask array ``x`` (..., m, n), each chunk passed through the NumPy ``check``
+    at compute time (errors name the global batch index). Nothing is computed now;
+    the checks travel with ``x`` itself (a check deferred on a value derived from
+    ``x``, such as a Hadamard ratio, would go with that value only)."""
+    if not validation_enabled():
+        return x
+    return dask_backend.map_batched(
+        functools.partial(_passed, check),
+        [x],
+        [2],
+        _relabel,
+        outputs=[(tuple(x.shape[-2:]), x.dtype)],
+    )
