@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._engine.dask_backend import is_dask
 from .._engine.namespace import is_numpy, namespace_of
 from .._validate import as_array, check_finite, to_numpy
 from ..functional import quaternion as _fq
@@ -78,12 +79,14 @@ class Quaternion(BatchedArray):
         """
         v = as_array(vector, (3,), "vector part")
         xp = namespace_of(v, scalar)
-        if is_numpy(xp):
-            s = scalar if isinstance(scalar, (int, float)) else np.asarray(scalar)
-            dt = np.result_type(v, s)
+        if is_numpy(xp):  # NumPy or Dask (kept lazy: asarray of one computes it)
+            s = scalar
+            if not isinstance(s, (int, float)) and not is_dask(s):
+                s = np.asarray(s)
+            dt = np.result_type(v.dtype, s if isinstance(s, (int, float)) else s.dtype)
             dt = dt if dt.kind == "f" else np.dtype(np.float64)
-            v = np.asarray(v, dtype=dt)
-            s = np.asarray(s, dtype=dt)
+            v = _cast(v, dt)
+            s = np.asarray(s, dtype=dt) if isinstance(s, (int, float)) else _cast(s, dt)
         else:
             s = xp.asarray(scalar, dtype=v.dtype)
         batch = tuple(np.broadcast_shapes(tuple(s.shape), tuple(v.shape[:-1])))
@@ -200,7 +203,8 @@ class Quaternion(BatchedArray):
             return None
         xp = namespace_of(self._q, s)
         if is_numpy(xp):
-            s = np.asarray(s)
+            if not is_dask(s):  # (np.asarray of a Dask array would compute it)
+                s = np.asarray(s)
             if s.dtype.kind not in "fiu":
                 return None
         else:
@@ -252,3 +256,8 @@ class Quaternion(BatchedArray):
     def _repr_single(self):
         vals = ", ".join(repr(c) for c in to_numpy(self._q).tolist())
         return f"Quaternion([{vals}])"
+
+
+def _cast(a, dtype):
+    """A NumPy or Dask array with ``dtype`` (Dask's ``astype`` stays lazy)."""
+    return a if a.dtype == dtype else a.astype(dtype)
