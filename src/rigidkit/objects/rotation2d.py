@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from .._engine.namespace import is_numpy, is_torch, namespace_of
+from .._engine.namespace import is_torch, namespace_of
 from .._validate import as_array, check_finite, finite_array, to_numpy
 from ..errors import ShapeError
 from ..functional import so2 as _so2
@@ -164,7 +164,7 @@ class Rotation2D(BatchedArray, LieGroup, family="plane", rank=0):
             import torch
 
             return torch.complex(c, s)
-        if is_numpy(namespace_of(self._data)):
+        if isinstance(self._data, np.ndarray):  # (a Dask array takes the lazy sum below)
             out = np.empty(c.shape, dtype=np.result_type(c.dtype, np.complex64))
             out.real = c
             out.imag = s
