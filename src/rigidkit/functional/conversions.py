@@ -41,8 +41,10 @@ import math
 
 import numpy as np
 
+from .._engine import dask_backend
 from .._engine.namespace import namespace_of
 from .._validate import (
+    _relabel,
     all_true,
     as_array,
     check_finite,
@@ -255,7 +257,21 @@ def nearest_rotation_matrix(matrix):
     ``matrix`` (..., 3, 3) must be finite (checked before the SVD, which can hang
     on infinities); a rank-deficient matrix gets one of its nearest rotations.
     """
-    m = finite_array(matrix, (3, 3), "matrix")
+    m = as_array(matrix, (3, 3), "matrix")
+    if dask_backend.is_dask(m):  # Dask's SVD takes one 2D matrix: one per element,
+        return dask_backend.map_batched(  # each chunk checked finite before its SVD
+            _nearest_rotation_numpy, [m], [2], _relabel, outputs=[((3, 3), m.dtype)]
+        )
+    check_finite(m, (3, 3), "matrix")
+    return _nearest_rotation(m)
+
+
+def _nearest_rotation_numpy(m):
+    check_finite(m, (3, 3), "matrix")
+    return _nearest_rotation(m)
+
+
+def _nearest_rotation(m):
     xp = namespace_of(m)
     u, _, vt = xp.linalg.svd(m)
     d = xp.linalg.det(u @ vt)
