@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._engine import dask_backend
 from .._engine.namespace import device_of, namespace_of
 from .._validate import (
     as_array,
@@ -118,8 +119,12 @@ def _left_jacobian(xi):
 
 
 def _left_jacobian_inverse(xi):
-    xp = namespace_of(xi)
-    return xp.linalg.inv(_left_jacobian(xi))
+    J = _left_jacobian(xi)
+    if dask_backend.is_dask(J):  # Dask's LU takes one 2D matrix: one per element
+        return dask_backend.map_batched(
+            np.linalg.inv, [J], [2], outputs=[((7, 7), J.dtype)]
+        )
+    return namespace_of(J).linalg.inv(J)
 
 
 def left_jacobian(xi):
