@@ -504,7 +504,11 @@ def test_container_protocol_and_pickle(rng):
     assert repr(rk.Transform()) == (
         "Transform(rotation=Rotation.from_quat([1, 0, 0, 0]), translation=[0, 0, 0])"
     )
-    assert repr(T) == "Transform(shape=(3, 4), dtype=float64)"
+    # A batch: its shape and dtype, then its values under its components' names
+    # (NumPy's summary of them: tests/test_first_hour.py checks the values).
+    assert repr(T).startswith(
+        "Transform(shape=(3, 4), dtype=float64, (qw, qx, qy, qz, tx, ty, tz)=\n"
+    )
     assert isinstance(T, rk.objects.group.LieGroup)
     assert (T.dof, T.matrix_size, T.point_dim) == (6, 4, 3)
 

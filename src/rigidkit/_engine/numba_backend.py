@@ -468,3 +468,11 @@ def _plain_errors():
         return
     if type(errors._termcolor_inst).__name__ != "NOPColorScheme":
         errors._termcolor_inst = _PlainErrors()
+    # Modules that numba imported meanwhile keep the scheme of their import time
+    # (``_termcolor = errors.termcolor()`` in numba.core.types.functions, ir,
+    # typing.typeof, compiler_machinery): the one that formats typing errors.
+    for name, module in list(sys.modules.items()):
+        if name.startswith("numba.") and type(
+            getattr(module, "_termcolor", None)
+        ).__name__ not in ("NoneType", "NOPColorScheme", "_PlainErrors"):
+            module._termcolor = errors._termcolor_inst
