@@ -65,15 +65,11 @@ NUMBA_MIN = (
 #: Tests set it to check one binding; the fast path steps aside when it is set.
 BINDING = None
 
-#: Whether a NumPy call whose compiled loop is not ready asks the background thread
-#: for it, to use from the next call on (True, the default). False
-#: (``RIGIDKIT_BACKGROUND_COMPILE=0``): a loop is compiled only where a caller waits
-#: for it (``backend="numba"``, ``RIGIDKIT_NUMBA_MIN``, ``rigidkit precompile``),
-#: and every other batch is served by the Python-float and element-wise NumPy
-#: bindings. For processes that call many kernels a few times each, where each
-#: speculative compile (1-3 s of CPU) costs more than it saves: the test suite,
-#: which checks each kernel's compiled loop once (tests/test_engine.py) instead of
-#: every broadcast pattern and dtype that other tests happen to meet.
+#: Whether a NumPy call whose loop is not ready asks the background thread for it
+#: (True, the default). ``RIGIDKIT_BACKGROUND_COMPILE=0``: a loop is compiled only
+#: where a caller waits for it (``backend="numba"``, ``RIGIDKIT_NUMBA_MIN``,
+#: ``rigidkit precompile``), for processes that call many kernels a few times each
+#: (the test suite), where each speculative compile (1-3 s of CPU) costs more than it saves.
 BACKGROUND = os.environ.get("RIGIDKIT_BACKGROUND_COMPILE", "1") != "0"
 
 #: A kernel called this many times on one element asks for a compiled one-element
