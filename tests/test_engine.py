@@ -792,8 +792,6 @@ SYMPY_SKIP = {
     "geodesic.pose_slerp_decoupled": "nested exp(t log) expression: SymPy runs for minutes",
     "geodesic.quat_slerp": "nested exp(t log) expression: SymPy runs for minutes",
     "geodesic.quat_power": "nested exp(t log) expression: SymPy runs for minutes",
-    "geodesic.quat_slerp_relative": "quat_slerp's expression from its relative "
-    "rotation: over symbols the Piecewise of the power compares NaN",
     "rot6d.quat_from_rot6d": "Gram-Schmidt inside Shepperd's branches: the symbolic "
     "Piecewise compares NaN (its parts, normalize4 and quat_from_matrix, are checked)",
     "davenport.davenport_from_quat": "reduction to XYX through euler_from_quat over "

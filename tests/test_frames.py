@@ -163,18 +163,15 @@ def test_interpolation_is_rk_slerp(decoupled):
         np.testing.assert_allclose(one, want[k], atol=1e-14)
 
 
-def test_decoupled_kernels_from_segment_steps_are_slerp():
-    """The kernels of the batched decoupled lookup, ``q0 d^t`` from the relative
-    rotation ``d = q0* q1`` and the position ``p0 + t (p1 - p0)``, against
-    ``quat_slerp`` and ``pose_slerp_decoupled`` of the two ends (including
-    opposite quaternions and coincident ends), in float64 and float32."""
-    from rigidkit.kernels.geodesic import (
-        pose_from_quat_lerp,
-        pose_slerp_decoupled,
-        quat_slerp,
-        quat_slerp_relative,
-    )
-    from rigidkit.kernels.quaternion import quat_multiply
+def test_decoupled_segment_kernel_is_slerp():
+    """The kernel of the batched decoupled lookup, ``(q0 (cos(a phi), sin(a phi)
+    u), p0 + a d)`` at ``a = (t - t0) / dt`` from a segment's row (its relative
+    rotation's half angle and axis, taken once per segment by ``_segments``),
+    against ``quat_slerp`` and
+    ``pose_slerp_decoupled`` of the two ends, including opposite quaternions,
+    coincident ends and ends 1e-9 rad apart, in float64 and float32."""
+    from rigidkit.applications.frames.buffer import _segments
+    from rigidkit.kernels.geodesic import pose_slerp_decoupled, pose_slerp_segment
 
     rng = np.random.default_rng(21)
     n = 3000
@@ -182,21 +179,34 @@ def test_decoupled_kernels_from_segment_steps_are_slerp():
     q1 = np.array(rk.Rotation.random(n, rng=rng).as_quat())
     q1[:10] = -q0[:10]  # the same rotation, opposite signs
     q1[10:20] = q0[10:20]
+    tiny = rk.Rotation.from_rotvec(rng.normal(size=(10, 3)) * 1e-9)
+    q1[20:30] = np.asarray((rk.Rotation.from_quat(q0[20:30]) @ tiny).as_quat())
     p0, p1 = rng.normal(size=(n, 3)), rng.normal(size=(n, 3))
-    t = rng.uniform(-0.5, 1.5, n)
+    t = rng.uniform(0.0, 1.0, n)
+    # pairs of samples (q0[k], q1[k]) as rows 2k, 2k + 1: the even segments
+    pq = np.empty((2 * n, 7))
+    pq[0::2, :4], pq[1::2, :4], pq[0::2, 4:], pq[1::2, 4:] = q0, q1, p0, p1
+    stamps = 0.5 * np.arange(2 * n)  # segment 2k from k to k + 0.5
+    rows = _segments(pq, stamps, np.diff(stamps))[0::2]
+    np.testing.assert_array_equal(rows[:, 14:], np.c_[np.arange(n), np.full(n, 0.5)])
+    # each segment's own start and length, of float32's scale
+    rows[:, 14], rows[:, 15] = rng.uniform(-1.0, 1.0, n), rng.uniform(0.5, 2.0, n)
+    at = rows[:, 14] + t * rows[:, 15]
     for dtype, tol in ((np.float64, 1e-14), (np.float32, 2e-6)):
-        a, b, s = q0.astype(dtype), q1.astype(dtype), t.astype(dtype)
-        d = quat_multiply(a * np.array([1, -1, -1, -1], dtype), b)
-        got = quat_slerp_relative(a, d, s)
+        s = t.astype(dtype)
+        got = pose_slerp_segment(rows.astype(dtype), at.astype(dtype))
         assert got.dtype == dtype
-        np.testing.assert_allclose(got, quat_slerp(a, b, s), atol=tol)
-        pose = pose_from_quat_lerp(got, p0.astype(dtype), (p1 - p0).astype(dtype), s)
         want = pose_slerp_decoupled(
-            np.concatenate([a, p0.astype(dtype)], -1),
-            np.concatenate([b, p1.astype(dtype)], -1),
+            np.concatenate([q0, p0], -1).astype(dtype),
+            np.concatenate([q1, p1], -1).astype(dtype),
             s,
         )
-        np.testing.assert_allclose(pose, want, atol=4 * tol)
+        np.testing.assert_allclose(got, want, atol=4 * tol)
+    # the ends: exactly q0 at t = 0, the rotation of q1 at t = 1
+    start = pose_slerp_segment(rows, rows[:, 14])
+    np.testing.assert_array_equal(start, np.concatenate([q0, p0], -1))
+    end = pose_slerp_segment(rows, rows[:, 14] + rows[:, 15])[:, :4]
+    np.testing.assert_allclose(np.abs(np.einsum("ij,ij->i", end, q1)), 1.0, atol=1e-14)
 
 
 @pytest.mark.parametrize("interpolation", ["decoupled", "screw"])

@@ -81,26 +81,28 @@ def quat_slerp(w0, x0, y0, z0, w1, x1, y1, z1, t):
     return quat_slerp_entries(w0, x0, y0, z0, w1, x1, y1, z1, t)
 
 
-@kernel(inputs=[(4,), (4,), ()], outputs=[(4,)], vector_math=True)
-def quat_slerp_relative(w0, x0, y0, z0, dw, dx, dy, dz, t):
-    """:func:`quat_slerp` from ``q0`` and the relative rotation ``d = q0* q1``: ``q0 d^t``.
+@kernel(inputs=[(16,), ()], outputs=[(7,)])
+def pose_slerp_segment(w, x, y, z, px, py, pz, dx, dy, dz, phi, ux, uy, uz, t0, dt, t):
+    """Decoupled interpolation at time ``t`` on a segment given by one row of 16.
 
-    The same expression as :func:`quat_slerp` once ``d`` is known, for many ``t``
-    between the same two rotations (samples of a time series: ``d`` is taken once
-    per pair). One fused pass, vectorised like :func:`quat_slerp`.
+    The row is ``(q0, p0, d, phi, u, t0, dt)``: the first sample's quaternion and
+    position, the position step ``d = p1 - p0``, the relative rotation ``q0* q1 =
+    (cos phi, sin phi u)`` as its half angle ``phi`` in [0, pi/2] (flipped to ``w
+    >= 0``) and unit axis ``u`` (0 when ``phi = 0``), and the segment's start
+    ``t0`` and length ``dt``. With ``a = (t - t0) / dt`` it returns the pose
+    ``(q0 (cos(a phi), sin(a phi) u), p0 + a d)`` in the layout ``(w, x, y, z,
+    tx, ty, tz)``: :func:`pose_slerp_decoupled` (whose power is
+    :func:`quat_power_entries`) with the angle and axis taken once per pair of
+    samples instead of at every time. One sine and one cosine a pose, no
+    arctangent or square root, for many times on few segments (a time series
+    resampled), from one row gathered per time. No small-angle series is needed:
+    ``u = 0`` at ``phi = 0`` gives ``q0`` exactly.
     """
-    return quat_times_power(w0, x0, y0, z0, dw, dx, dy, dz, t)
-
-
-@kernel(inputs=[(4,), (3,), (3,), ()], outputs=[(7,)])
-def pose_from_quat_lerp(w, x, y, z, px, py, pz, dx, dy, dz, t):
-    """The pose ``(q, p + t d)``: a rotation and the point ``t`` of the way along ``d``.
-
-    With ``d = p1 - p0`` this is the translation of decoupled interpolation
-    (:func:`pose_slerp_decoupled`) from a step taken once per pair of samples,
-    packed with its rotation in the pose layout ``(w, x, y, z, tx, ty, tz)``.
-    """
-    return (w, x, y, z, px + t * dx, py + t * dy, pz + t * dz)
+    a = (t - t0) / dt
+    c = cos(a * phi)
+    s = sin(a * phi)
+    qw, qx, qy, qz = quat_multiply(w, x, y, z, c, s * ux, s * uy, s * uz)
+    return (qw, qx, qy, qz, px + a * dx, py + a * dy, pz + a * dz)
 
 
 @helper
