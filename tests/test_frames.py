@@ -695,3 +695,34 @@ def test_torch_gradient_through_a_dynamic_edge_equals_finite_differences(
         e[j] = 1e-6
         fd[j] = (loss_np(X + e) - loss_np(X - e)) / 2e-6
     np.testing.assert_allclose(got.numpy(), fd, rtol=1e-6, atol=1e-7)
+
+
+def test_edge_kind_errors_name_the_edge():
+    """Using an edge as the other kind raises ``rk.EdgeKindError`` (a ValueError)
+    naming the edge: samples on a static edge, a static pose on a dynamic one, a
+    second static pose, ``update_static`` of a dynamic edge, and torch samples
+    added one call after another; the graph is unchanged after each."""
+    T = rk.Transform(translation=[1.0, 0.0, 0.0])
+    moving = rk.Transform(translation=[[0.0, 0, 0], [1.0, 0, 0]])
+    g = rk.FrameGraph()
+    g.add("map", "odom", T)
+    g.add("odom", "base", moving, stamps=[0.0, 1.0])
+    cases = [
+        (lambda: g.add("map", "odom", moving, stamps=[2.0, 3.0]), "'map' -> 'odom'"),
+        (lambda: g.add("odom", "base", T), "'odom' -> 'base'"),
+        (lambda: g.add("map", "odom", T), "update_static"),
+        (lambda: g.update_static("odom", "base", T), "'odom' -> 'base' is dynamic"),
+    ]
+    for call, words in cases:
+        with pytest.raises(rk.EdgeKindError, match=words) as info:
+            call()
+        assert isinstance(info.value, ValueError)
+    assert [(e.child, e.kind, e.count) for e in g.edges] == [
+        ("odom", "static", 1),
+        ("base", "dynamic", 2),
+    ]
+    np.testing.assert_allclose(g.get("map", "base", at=0.5).translation, [1.5, 0, 0])
+    torch = pytest.importorskip("torch")
+    g.add("base", "arm", rk.Transform(translation=torch.zeros(2, 3)), stamps=[0.0, 1.0])
+    with pytest.raises(rk.EdgeKindError, match="'base' -> 'arm'"):
+        g.add("base", "arm", rk.Transform(translation=torch.ones(3)), stamps=2.0)

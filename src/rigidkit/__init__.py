@@ -11,6 +11,7 @@ from .errors import (  # noqa: F401  (exported below as listed in errors.__all__
     ConnectivityError,
     ConvergenceWarning,
     DegenerateInputError,
+    EdgeKindError,
     EulerSequenceError,
     ExtrapolationError,
     FrameKeywordError,

@@ -28,6 +28,7 @@ __all__ = [
     "FrameKeywordError",
     "ExtrapolationError",
     "ConnectivityError",
+    "EdgeKindError",
     "LookupError",
     "GimbalLockWarning",
     "ConvergenceWarning",
@@ -192,6 +193,16 @@ class GimbalLockWarning(UserWarning):
 class ConvergenceWarning(UserWarning):
     """An iteration (the Karcher mean, a spline solve) stopped at its step limit
     before reaching its tolerance; the last iterate is returned."""
+
+
+class EdgeKindError(RigidkitError):
+    """An edge of a :class:`~rigidkit.FrameGraph` used as the other kind: stamped
+    samples added to a static edge, a static pose to a dynamic one or a second
+    one to a static edge (``update_static`` replaces it; of a dynamic edge it
+    raises this too), or torch, JAX or Dask samples added to
+    a dynamic edge after its first ``add`` (such an edge takes all its samples in
+    one call: its arrays are not written in place). The message names the edge.
+    """
 
 
 class TimestampError(RigidkitError):

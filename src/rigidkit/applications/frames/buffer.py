@@ -16,7 +16,7 @@ import numpy as np
 
 from ..._engine import dask_backend
 from ..._engine.namespace import namespace_of
-from ...errors import ExtrapolationError
+from ...errors import EdgeKindError, ExtrapolationError
 from ...kernels.geodesic import pose_slerp as _slerp_screw
 from ...kernels.geodesic import pose_slerp_decoupled as _slerp_decoupled
 from ...kernels.geodesic import pose_slerp_segment as _slerp_segment
@@ -377,7 +377,7 @@ class EdgeBuffer:
         """Add samples (any order); a stamp already held is replaced by the new pose."""
         lo, hi = self._lo, self._hi
         if _foreign(pq) or _foreign(self._pq):
-            raise ValueError(
+            raise EdgeKindError(
                 f"edge {self.parent!r} -> {self.child!r}: samples of torch, JAX or "
                 "Dask poses are given at once (add them with all their stamps)"
             )

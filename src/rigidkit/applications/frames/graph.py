@@ -9,6 +9,7 @@ import numpy as np
 from ..._engine import Lock
 from ...errors import (
     ConnectivityError,
+    EdgeKindError,
     ExtrapolationError,
     FrameKeywordError,
     LookupError,
@@ -116,9 +117,10 @@ class FrameGraph:
         ------
         ConnectivityError
             ``child`` already has another parent, or the edge closes a cycle.
-        ValueError
-            Static samples for a dynamic edge or the reverse, or a second static
-            pose (use :meth:`update_static`).
+        EdgeKindError
+            Static samples for a dynamic edge or the reverse, a second static
+            pose (use :meth:`update_static`), or torch, JAX or Dask samples added
+            to a dynamic edge that has some.
         """
         t, pq, cov = as_samples(parent_T_child, stamps, cov)
         parent, child = str(parent), str(child)
@@ -137,7 +139,7 @@ class FrameGraph:
                 hint = (
                     "; use update_static to replace it" if edge.static and t is None else ""
                 )
-                raise ValueError(
+                raise EdgeKindError(
                     f"edge {parent!r} -> {child!r} is {kind}, cannot add "
                     f"{'a static pose' if t is None else 'stamped samples'} to it{hint}"
                 )
@@ -160,7 +162,7 @@ class FrameGraph:
             if edge is None:
                 pass
             elif not edge.static:
-                raise ValueError(
+                raise EdgeKindError(
                     f"edge {edge.parent!r} -> {child!r} is dynamic, not static"
                 )
             else:
