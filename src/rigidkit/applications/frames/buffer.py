@@ -145,19 +145,38 @@ class Snapshot:
 
         ``i`` is the number of interior stamps ``t[1], ..., t[N - 2]`` at or before
         each time (``searchsorted(t, q, "right") - 1``, clipped to the last
-        segment). Times in increasing order (a replay, a resampling) are counted
-        from the other side: where each interior stamp falls among the times,
-        ``O(N log M)``, then a run of indices per segment, instead of a binary
-        search per time (``O(M log N)``, ~10x slower at M = 1e5, N = 2,000).
+        segment). Times in increasing order (a replay, a resampling, more of them
+        than samples) are counted from the other side (:meth:`_runs`) instead of
+        by a binary search per time (``O(M log N)``, ~10x slower at M = 1e5, N =
+        2,000).
         """
+        runs = self._runs(q)
+        if runs is not None:
+            return np.repeat(np.arange(self.t.shape[0] - 1), runs)
+        i = self.t.searchsorted(q, side="right") - 1
+        np.clip(i, 0, self.t.shape[0] - 2, out=i)
+        return i
+
+    def _runs(self, q):
+        """For times ``q`` in increasing order and more of them than samples: how
+        many fall in each segment (N - 1,), from where each interior stamp falls
+        among the times (``O(N log M)``); else None."""
         t = self.t
         n, m = t.shape[0], q.shape[0]
-        if m > n and not (q[1:] < q[:-1]).any():
-            cut = q.searchsorted(t[1:-1], side="left")
-            return np.repeat(np.arange(n - 1), np.diff(cut, prepend=0, append=m))
-        i = t.searchsorted(q, side="right") - 1
-        np.clip(i, 0, n - 2, out=i)
-        return i
+        if m <= n or (q[1:] < q[:-1]).any():
+            return None
+        ends = np.empty(n, dtype=np.intp)
+        ends[0], ends[-1] = 0, m
+        ends[1:-1] = q.searchsorted(t[1:-1], side="left")
+        return ends[1:] - ends[:-1]
+
+    def rows(self, q):
+        """The rows of :meth:`increments` ``("decoupled")`` of each time's segment."""
+        table = self.increments("decoupled")
+        runs = self._runs(q)
+        if runs is not None:  # a run of one row per segment: ~12% faster than take
+            return np.repeat(table, runs, axis=0)
+        return np.take(table, self.index(q), axis=0)
 
     def locate(self, q, many=None):
         """Segment index ``i`` (:meth:`index`) and fraction ``a`` of each time
@@ -205,8 +224,7 @@ class Snapshot:
         tables = 4 * many >= pq.shape[0] and not _foreign(pq)
         want_cov = want_cov and self.cov is not None
         if tables and interpolation == "decoupled" and not want_cov:
-            rows = np.take(self.increments("decoupled"), self.index(q), axis=0)
-            return wrap_pq(_slerp_segment(rows, q)), None
+            return wrap_pq(_slerp_segment(self.rows(q), q)), None
         i, a = self.locate(q, many)
         if tables:
             T = self._from_increments(i, a, interpolation)
