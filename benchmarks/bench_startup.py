@@ -6,8 +6,10 @@ that imports rigidkit, then calls one op on one element in blocks of
 ``--block`` calls for ``--seconds`` seconds, and reports each block's time per
 call with the time since ``import rigidkit`` began. Per time window the median
 over the blocks of a run, then the median over ``--runs`` runs, and the ratio
-of each window to the steady state (the last window). Also the import time
-(median over the runs).
+of each window to the steady state (the last window). Also the time from
+import to the loops of the op's first calls, the caller idle and the caller
+calling the op all along (sharing the GIL with the loading thread), and the
+import time (medians over the runs).
 
     python benchmarks/bench_startup.py
     python benchmarks/bench_startup.py --ops as_matrix compose --runs 7
@@ -89,12 +91,32 @@ print(json.dumps({{"import": t1 - t0, "wall": time.perf_counter() - t1,
 """
 
 
-def run_ready(op, env):
+_SPIN = r"""
+import time, json
+import numpy as np
+import rigidkit as rk
+from rigidkit._engine import numba_backend
+t1 = time.perf_counter()
+{setup}
+def call():
+    {call}
+jobs = numba_backend._PENDING
+while True:  # the caller busy: it and the loading thread share the GIL
+    for _ in range(200):
+        call()
+    if jobs and all(j.done.is_set() for j in list(jobs.values())):
+        break
+print(json.dumps({{"wall": time.perf_counter() - t1}}))
+"""
+
+
+def run_ready(op, env, spin=False):
     """Seconds from import to the loops of ``op``'s first calls ready, the caller
     idle (wall and the process's CPU time, import included: the latter hardly
-    depends on the machine's load)."""
+    depends on the machine's load), or ``spin``: the caller calling ``op`` all
+    along (wall only)."""
     setup, call = OPS[op]
-    src = _READY.format(setup=setup, call=call)
+    src = (_SPIN if spin else _READY).format(setup=setup, call=call)
     res = subprocess.run(
         [sys.executable, "-c", src], capture_output=True, text=True, env=env, check=True
     )
@@ -191,7 +213,10 @@ def main(argv=None):
             f"{op}: loops ready {wall * 1e3:.0f} ms after import (caller idle), "
             f"process CPU from import to ready {cpu * 1e3:.0f} ms"
         )
-        report.setdefault(op, {}).update(ready_s=wall, ready_cpu_s=cpu)
+        spun = statistics.median(run_ready(op, env, True)["wall"] for _ in range(args.runs))
+        pad = " " * (len(op) + 2)
+        print(f"{pad}loops ready {spun * 1e3:.0f} ms after import (caller spinning)")
+        report.setdefault(op, {}).update(ready_s=wall, ready_cpu_s=cpu, ready_spin_s=spun)
     imp = statistics.median(imports)
     print(f"import rigidkit: {imp * 1e3:.0f} ms (median of {len(imports)} processes)")
     report["import_s"] = imp

@@ -74,3 +74,93 @@ def test_default_queues_the_loops(tmp_path):
     out = _run(tmp_path, None)
     assert out["queued"] >= 2, out  # at least a batch loop per dtype
     assert out["worst"] <= 4, out
+
+
+# A long switch interval magnifies the GIL's convoy effect (numba_loads.switch_fast):
+# without the lowered interval the loading thread waited a whole interval for the
+# GIL after each of its ~2000 file reads, stats and llvmlite calls whenever the
+# caller's thread took it meanwhile (4 s to the loop at 50 ms, 0.4-0.7 s with it).
+_SPIN = textwrap.dedent(
+    """
+    import json, sys, time
+    sys.setswitchinterval(0.1)
+    import numpy as np
+    t0 = time.perf_counter()
+    import rigidkit as rk
+    from rigidkit._engine import numba_backend
+
+    R = rk.Rotation.from_quat(np.array([0.5, 0.5, 0.5, 0.5]))
+    ready, jobs = None, []
+    while time.perf_counter() - t0 < 30:  # the caller never idle: it shares the GIL
+        for _ in range(200):
+            R.as_matrix()
+        jobs = list(numba_backend._PENDING.values())
+        if jobs and all(j.done.is_set() for j in jobs):
+            ready = time.perf_counter() - t0
+            break
+    print(json.dumps({"ready": ready, "queued": len(jobs),
+                      "errors": [repr(j.error) for j in jobs if j.error is not None],
+                      "interval": sys.getswitchinterval()}))
+    """
+)
+
+
+def test_loops_load_while_the_caller_spins(tmp_path):
+    if not numba_backend.available():
+        pytest.skip("needs numba")
+    env = dict(os.environ, RIGIDKIT_CACHE_DIR=str(tmp_path))
+    for name in (
+        "RIGIDKIT_DISABLE_NUMBA",
+        "RIGIDKIT_BACKGROUND_COMPILE",
+        "RIGIDKIT_SWITCH_INTERVAL",
+    ):
+        env.pop(name, None)
+    # A warm cache first: the timed process only loads its loop from disk.
+    warm = (
+        "import numpy as np, rigidkit as rk\n"
+        "from rigidkit._engine import numba_backend\n"
+        "R = rk.Rotation.from_quat(np.array([0.5, 0.5, 0.5, 0.5]))\n"
+        "for _ in range(100):\n    R.as_matrix()\n"
+        "assert numba_backend.drain(300)\n"
+    )
+    for src in (warm, _SPIN):
+        res = subprocess.run(
+            [sys.executable, "-c", src],
+            capture_output=True,
+            text=True,
+            env=env,
+            timeout=300,
+        )
+        assert res.returncode == 0, res.stderr[-3000:]
+    out = json.loads(res.stdout.strip().splitlines()[-1])
+    assert out["queued"] >= 1 and not out["errors"], out
+    # ~0.4 s on an idle 2-core machine (numba's import and the load, ~0.17 s of
+    # CPU, sharing the GIL with the caller); 8 s or more before the fix.
+    assert out["ready"] is not None and out["ready"] < 4.0, out
+    assert out["interval"] == pytest.approx(0.1, abs=1e-6), out  # the caller's, restored
+
+
+def test_switch_interval_lowered_then_restored():
+    from rigidkit._engine import numba_loads
+
+    before = sys.getswitchinterval()
+    try:
+        sys.setswitchinterval(0.02)
+        numba_loads.switch_fast()
+        assert sys.getswitchinterval() == pytest.approx(numba_loads.SWITCH_INTERVAL)
+        numba_loads.switch_back()
+        assert sys.getswitchinterval() == 0.02  # exactly: no microsecond lost
+        # An interval the process sets meanwhile is its own: kept.
+        numba_loads.switch_fast()
+        sys.setswitchinterval(0.03)
+        numba_loads.switch_back()
+        assert sys.getswitchinterval() == 0.03
+        # Already shorter than ours: left alone.
+        sys.setswitchinterval(1e-4)
+        numba_loads.switch_fast()
+        assert sys.getswitchinterval() == pytest.approx(1e-4)
+        numba_loads.switch_back()
+        assert sys.getswitchinterval() == pytest.approx(1e-4)
+    finally:
+        numba_loads.switch_back()
+        sys.setswitchinterval(before)

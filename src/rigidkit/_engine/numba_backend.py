@@ -32,7 +32,7 @@ import sys
 import threading
 
 from .loop_source import SINGLE, loop_options, module_source
-from .numba_loads import jit_signatures
+from .numba_loads import jit_signatures, switch_back, switch_fast
 
 __all__ = [
     "PARALLEL_MIN",
@@ -289,6 +289,7 @@ def drain(timeout=None) -> bool:
 
 
 def _work():
+    switch_fast()  # numba's import first, at the quicker GIL hand-over
     # numba's warning filters and recordings kept on this thread (see compile_warnings).
     from . import compile_warnings
 
@@ -308,8 +309,15 @@ def _serve(compile_warnings):
     else:
         error = None
         _plain_errors()
+    import queue
+
     while True:
-        job = _JOBS.get()
+        try:
+            job = _JOBS.get_nowait()
+        except queue.Empty:
+            switch_back()  # nothing left to load: the caller's interval again
+            job = _JOBS.get()
+            switch_fast()
         try:
             if error is not None:
                 raise error
