@@ -96,7 +96,9 @@ def pose_slerp_segment(w, x, y, z, px, py, pz, dx, dy, dz, phi, ux, uy, uz, t0, 
     samples instead of at every time. One sine and one cosine a pose, no
     arctangent or square root, for many times on few segments (a time series
     resampled), from one row gathered per time. No small-angle series is needed:
-    ``u = 0`` at ``phi = 0`` gives ``q0`` exactly.
+    ``u = 0`` at ``phi = 0`` gives ``q0`` exactly. Not ``vector_math``: with rows
+    of 16 and poses of 7 the loop does not vectorise, and the branch-free sine
+    and cosine cost 24 ns an element in it, libm's 16.5.
     """
     a = (t - t0) / dt
     c = cos(a * phi)
