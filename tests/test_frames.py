@@ -726,3 +726,64 @@ def test_edge_kind_errors_name_the_edge():
     g.add("base", "arm", rk.Transform(translation=torch.zeros(2, 3)), stamps=[0.0, 1.0])
     with pytest.raises(rk.EdgeKindError, match="'base' -> 'arm'"):
         g.add("base", "arm", rk.Transform(translation=torch.ones(3)), stamps=2.0)
+
+
+def _cov_graph(lib, scale=1e-2):
+    """map -> odom (dynamic, covariances) -> base -> camera (static, covariance)."""
+    rng = np.random.default_rng(5)
+    moving = rk.Transform.random(2, rng=rng)
+    g = rk.FrameGraph()
+    cov = np.eye(6) * 0.5 + np.diag(rng.uniform(0.1, 1.0, 6))
+    g.add(
+        "map",
+        "odom",
+        rk.Transform.from_pq(lib(np.asarray(moving.as_pq()))),
+        stamps=[0.0, 1.0],
+        cov=scale * lib(np.stack([cov, 2.0 * cov])),
+    )
+    g.add(
+        "odom",
+        "base",
+        rk.Transform.from_pq(lib(np.asarray(rk.Transform.random(rng=rng).as_pq()))),
+    )
+    mount = rk.Transform.from_pq(lib(np.asarray(rk.Transform.random(rng=rng).as_pq())))
+    g.add("base", "camera", mount, cov=lib(np.eye(6) * 1e-3))
+    return g
+
+
+@pytest.mark.parametrize("at", [0.3, np.array([0.25, 0.5, 0.75])])
+def test_covariance_lookup_stays_in_torch_with_gradients(at):
+    """``get(..., with_covariance=True)`` on torch poses and covariances keeps the
+    covariance in torch (it was converted to NumPy, and a covariance that
+    required grad raised), equal to the NumPy graph's, and its gradient with
+    respect to an edge covariance's scale matches central differences of the
+    NumPy graph."""
+    torch = pytest.importorskip("torch")
+
+    def lib(x):
+        return torch.tensor(np.asarray(x), dtype=torch.float64)
+
+    want = _cov_graph(np.asarray).get("camera", "map", at=at, with_covariance=True)
+    got = _cov_graph(lib).get("camera", "map", at=at, with_covariance=True)
+    assert isinstance(got.cov, torch.Tensor)
+    np.testing.assert_allclose(got.cov.numpy(), want.cov, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(
+        got.mean.as_matrix().numpy(), want.mean.as_matrix(), atol=1e-14
+    )
+
+    scale = torch.tensor(1e-2, dtype=torch.float64, requires_grad=True)
+    weights = np.random.default_rng(6).normal(size=np.shape(want.cov))
+    out = _cov_graph(lib, scale=scale).get("camera", "map", at=at, with_covariance=True).cov
+    (out * lib(weights)).sum().backward()
+
+    def f(s):
+        cov = (
+            _cov_graph(np.asarray, scale=s)
+            .get("camera", "map", at=at, with_covariance=True)
+            .cov
+        )
+        return float((cov * weights).sum())
+
+    h = 1e-6
+    fd = (f(1e-2 + h) - f(1e-2 - h)) / (2 * h)
+    np.testing.assert_allclose(float(scale.grad), fd, rtol=1e-6)

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..._engine import dask_backend
-from ..._engine.namespace import namespace_of
+from ..._engine.namespace import device_of, namespace_of
 from ...errors import EdgeKindError, ExtrapolationError
 from ...kernels.geodesic import pose_slerp as _slerp_screw
 from ...kernels.geodesic import pose_slerp_decoupled as _slerp_decoupled
@@ -237,6 +237,9 @@ class Snapshot:
             )
         if want_cov:
             w = a[..., None, None]
+            if _foreign(self.cov):  # torch, JAX, Dask: the weights in its namespace
+                xp = namespace_of(self.cov)
+                w = xp.asarray(w, dtype=self.cov.dtype, device=device_of(self.cov))
             cov = (1.0 - w) * self.cov[i] + w * self.cov[i + 1]
         return T, cov
 

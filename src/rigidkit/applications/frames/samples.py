@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..._engine.namespace import device_of, namespace_of
 from ...errors import ShapeError, TimestampError
 from ...objects import registry
 from ...objects.transform import Transform
@@ -49,7 +50,7 @@ def as_samples(parent_T_child, stamps, cov):
         if not _foreign(pq):
             pq = np.ascontiguousarray(pq, dtype=np.float64)
         if cov is not None:
-            cov = _checked_cov(np.array(cov, dtype=np.float64), 1)
+            cov = _checked_cov(_as_cov(cov, pq), 1)
         return None, pq.reshape((1,) + tuple(pq.shape)), cov
     # A dynamic edge's stamps are NumPy (searched on the host); its poses stay in
     # their namespace (torch, JAX, Dask), NumPy ones in a buffer written in place.
@@ -67,16 +68,33 @@ def as_samples(parent_T_child, stamps, cov):
         i = int(bad[0])
         raise TimestampError(f"stamps[{i}] is {float(t[i])!r}, not finite", index=(i,))
     if cov is not None:
-        cov = _checked_cov(np.array(cov, dtype=np.float64), pq.shape[0])
+        cov = _checked_cov(_as_cov(cov, pq), pq.shape[0])
     return t, (pq if _foreign(pq) else np.ascontiguousarray(pq)), cov
 
 
+def _as_cov(cov, pq):
+    """A covariance in the poses' namespace: a NumPy copy for NumPy poses (the
+    buffer's own array); for torch, JAX or Dask poses a covariance of theirs as
+    its copy (autograd through it, tracing), anything else converted to it."""
+    if not _foreign(pq):
+        return np.array(cov, dtype=np.float64)
+    xp = namespace_of(pq)
+    if _foreign(cov):
+        return xp.asarray(cov, copy=True)  # not the caller's storage
+    return xp.asarray(
+        np.asarray(cov, dtype=np.float64), dtype=pq.dtype, device=device_of(pq)
+    )
+
+
 def _checked_cov(cov, m):
-    """``cov`` (6, 6) or (m, 6, 6) as (m, 6, 6)."""
-    if cov.shape == (6, 6):
+    """``cov`` (6, 6) or (m, 6, 6) as (m, 6, 6), in its namespace."""
+    shape = tuple(cov.shape)
+    if shape == (6, 6):
+        if _foreign(cov):
+            return namespace_of(cov).broadcast_to(cov[None], (m, 6, 6))
         cov = np.broadcast_to(cov, (m, 6, 6)).copy()
-    if cov.shape != (m, 6, 6):
-        raise ShapeError(f"cov: expected shape (6, 6) or ({m}, 6, 6), got {cov.shape}")
+    elif shape != (m, 6, 6):
+        raise ShapeError(f"cov: expected shape (6, 6) or ({m}, 6, 6), got {shape}")
     return cov
 
 

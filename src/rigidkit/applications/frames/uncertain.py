@@ -21,6 +21,7 @@ import numpy as np
 
 from ..._engine.namespace import device_of, is_numpy, namespace_of
 from ...errors import ShapeError
+from ...objects import registry
 from ...objects._batch import expect
 from ...objects.transform import Transform
 from .. import jacobians as _jac
@@ -315,15 +316,20 @@ def path_covariance(up_s, up_t, q, shape, interpolation, extrapolate):
     Each edge is an :class:`UncertainTransform` of its pose and covariance (zero
     where the edge has none); chains compose from the top down and the target's
     chain is inverted, as in :func:`~rigidkit.applications.frames.lookup.compose_path`.
+    The covariance stays in the poses' namespace (torch autograd, JAX tracing).
     """
     from .lookup import chain, shaped
+
+    def zeros(E):
+        stored = registry.stored(E)
+        xp = namespace_of(stored)
+        return xp.zeros(E.shape + (6, 6), dtype=stored.dtype, device=device_of(stored))
 
     def uncertain(up):
         _, parts = chain(up, q, interpolation, extrapolate, want_cov=True)
         out = None
         for E, cov in parts:
-            cov = np.zeros(E.shape + (6, 6)) if cov is None else cov
-            U = UncertainTransform(E, cov)
+            U = UncertainTransform(E, zeros(E) if cov is None else cov)
             out = U if out is None else out.compose(U)
         return out
 
@@ -335,9 +341,11 @@ def path_covariance(up_s, up_t, q, shape, interpolation, extrapolate):
     else:
         U = A_t.between(A_s)
     mean = shaped(U.mean, shape)
-    cov = np.asarray(U.cov)
+    cov = U.cov
+    xp = namespace_of(cov)
     if U.mean.single:
-        cov = np.broadcast_to(cov, mean.shape + (6, 6)).copy()
+        cov = xp.broadcast_to(cov, mean.shape + (6, 6))
+        cov = cov.copy() if is_numpy(cov) else xp.asarray(cov, copy=True)
     else:
-        cov = cov.reshape(mean.shape + (6, 6))
+        cov = xp.reshape(cov, mean.shape + (6, 6))
     return UncertainTransform(mean, cov, "right")
