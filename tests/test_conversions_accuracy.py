@@ -592,6 +592,10 @@ COEF_REFS = {
         1,
     ),
     "exprel": (_ref_even(lambda x: mp.expm1(x) / x, 1), 1),
+    # The forms given the sine (and cosine): swept through sin_defect3 and
+    # sin_cos_defect5, which pass sin(x), cos(x) to them.
+    "sin_defect3_from_sin": (lambda x, s: COEF_REFS["sin_defect3"][0](x), 2),
+    "sin_cos_defect5_from_sincos": (lambda x, s, c: COEF_REFS["sin_cos_defect5"][0](x), 3),
     "atan_ratio": (lambda n, w: mp.atan2(mp.mpf(n), mp.mpf(w)) / mp.mpf(n), 2),
     "norm3": (lambda x, y, z: mp.sqrt(mp.mpf(x) ** 2 + mp.mpf(y) ** 2 + mp.mpf(z) ** 2), 3),
 }
