@@ -213,10 +213,29 @@ def group_rows(rk, repeat):
     }
     from rigidkit._engine import numba_backend
 
-    for f in fns.values():  # the first batch over PARALLEL_MIN asks for the threaded loop
-        f()
-    numba_backend.drain(timeout=600)
-    med = C.interleaved_medians(fns, repeat=repeat, min_sample=0.2)
+    # A batch over PARALLEL_MIN runs on the threads the load average leaves idle,
+    # decided per call, and asks for its threaded loop only when that is more than
+    # one. Left to that, the two sides of a row can run on different thread
+    # counts: after the preintegration rows (two threads) the warm-up may see no
+    # idle core, and a loop asked for mid-timing runs one side on one thread while
+    # its build lasts. ExtendedPose exp once came out 2.34x Transform's on a quiet
+    # 2-core machine: about 2x the 1.1-1.16x that the two kernels differ by per
+    # element (CPU time, interleaved, these sizes), as one thread against two
+    # gives. So every threaded loop is built first, and both sides of every row
+    # run on the same threads, chosen once.
+    saved = os.environ.get("RIGIDKIT_NUM_THREADS")
+    os.environ["RIGIDKIT_NUM_THREADS"] = str(max(2, C.cpu_count()))
+    try:
+        for f in fns.values():
+            f()
+        numba_backend.drain(timeout=600)
+        os.environ["RIGIDKIT_NUM_THREADS"] = str(saved or numba_backend.idle_workers())
+        med = C.interleaved_medians(fns, repeat=repeat, min_sample=0.2)
+    finally:
+        if saved is None:
+            del os.environ["RIGIDKIT_NUM_THREADS"]
+        else:
+            os.environ["RIGIDKIT_NUM_THREADS"] = saved
     rows = []
     for op in ("compose", "exp", "log"):
         a = _median(med, f"ExtendedPose {op}") / n * 1e9
