@@ -47,28 +47,39 @@ def _single_source(kernel) -> str:
     """One evaluation on arrays of exactly their trailing shapes (see ``SINGLE``).
 
     Inputs are read by their own indices (``A0[1, 2]``), not through a flat view:
-    they may be strided (see :func:`signature`).
+    they may be strided (see :func:`signature`). Outputs are written by theirs
+    too: a ``reshape`` would be numba's ``normalize_reshape_value``, whose
+    environment, read back with the loop from the disk cache, imports
+    ``numba.np.arrayobj`` (20 ms of the background thread's ~170 before a
+    script's first loop is ready).
     """
     nparams = len(kernel.params)
     args = [f"p{k}" for k in range(nparams)]
-    pre, call = [], [f"p{k}" for k in range(nparams)]
+    call = [f"p{k}" for k in range(nparams)]
     for k, shape in enumerate(kernel.inputs):
         args.append(f"A{k}")
-        for c in range(_size(shape)):
-            index, rest = [], c
-            for d in reversed(shape):
-                index.insert(0, str(rest % d))
-                rest //= d
-            call.append(f"A{k}[{', '.join(index) or '()'}]")  # 0-d: A[()]
+        call += [f"A{k}[{index}]" for index in _indices(shape)]
     body = [f"    r = {kernel.name}({', '.join(call)})"]
     j = 0
     for k, shape in enumerate(kernel.outputs):
         args.append(f"O{k}")
-        pre.append(f"    o{k} = O{k}.reshape({_size(shape)})")
-        for c in range(_size(shape)):
-            body.append(f"    o{k}[{c}] = r[{j}]")
+        for index in _indices(shape):
+            body.append(f"    O{k}[{index}] = r[{j}]")
             j += 1
-    return f"def loop({', '.join(args)}):\n" + "\n".join(pre + body) + "\n"
+    return f"def loop({', '.join(args)}):\n" + "\n".join(body) + "\n"
+
+
+def _indices(shape) -> list[str]:
+    """The index of each element of an array of ``shape``, in C order: ``"1, 2"``
+    (a 0-d array's: ``"()"``)."""
+    out = []
+    for c in range(_size(shape)):
+        index, rest = [], c
+        for d in reversed(shape):
+            index.insert(0, str(rest % d))
+            rest //= d
+        out.append(", ".join(index) or "()")
+    return out
 
 
 def _loop_source(kernel, bcast=()) -> str:
