@@ -309,15 +309,9 @@ def _serve(compile_warnings):
     else:
         error = None
         _plain_errors()
-    import queue
-
     while True:
-        try:
-            job = _JOBS.get_nowait()
-        except queue.Empty:
-            switch_back()  # nothing left to load: the caller's interval again
-            job = _JOBS.get()
-            switch_fast()
+        job = _JOBS.get()
+        switch_fast()  # (a no-op while it is lowered)
         try:
             if error is not None:
                 raise error
@@ -333,6 +327,10 @@ def _serve(compile_warnings):
         except BaseException as exc:  # noqa: BLE001 - handed to whoever waits
             job.error = exc
         compile_warnings.isolate_numba_modules()  # and those it imported
+        if _JOBS.empty():
+            # Nothing left to load: the caller's interval again, before whoever
+            # waits for this job (drain) resumes.
+            switch_back()
         job.done.set()
 
 
