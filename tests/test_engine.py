@@ -63,6 +63,13 @@ torch = optional("torch")
 
 N = 2000
 TOL = 2e-15
+#: torch evaluates sin, cos, atan2, exp with its own vectorised functions (SLEEF),
+#: not the C library's that numba, NumPy and Python floats share, so the two
+#: differ in the last bits of each call, and nested formulas amplify that: on
+#: one CI host every kernel agreed within TOL, on another (same packages, another
+#: CPU and C library) geodesic.pose_power (exp(t log T)) differed by 3.6e-15 and
+#: imu_step_jacobian_midpoint by 2.3e-15, the other 200 within 1.3e-15.
+TORCH_TOL = 8e-15
 
 
 # -- the registry ----------------------------------------------------------------------
@@ -674,7 +681,7 @@ def test_torch_binding_agrees(name):
     k = KERNELS[name]
     ref = _numba(k, params, arrays)
     tensors = [torch.from_numpy(a) for a in arrays]
-    _close(k(*params, *tensors), ref, k.outputs, f"{name} torch vs numba")
+    _close(k(*params, *tensors), ref, k.outputs, f"{name} torch vs numba", tol=TORCH_TOL)
 
 
 @names
