@@ -156,12 +156,29 @@ for _fn in _OWN:
     setattr(SHIM, _fn.__name__, _fn)
 
 
+def loaded_modules() -> list:
+    """``sys.modules``'s items, read safely while other threads import.
+
+    ``list(sys.modules.items())`` walks the dict in steps between which Python
+    code can run (a collection triggered by an allocation, a finaliser), and
+    another thread's import then changes its size: ``RuntimeError: dictionary
+    changed size during iteration`` on the compile thread (seen in a test run, it
+    failed the job of every caller waiting on that loop). ``dict.copy`` copies the
+    table in one call that runs no Python code; the retry is for any other way.
+    """
+    while True:
+        try:
+            return list(sys.modules.copy().items())
+        except RuntimeError:  # pragma: no cover - the copy raced after all: again
+            continue
+
+
 def isolate_numba_modules() -> int:
     """Give every imported numba module :data:`SHIM` as its ``warnings``; returns
     how many were changed (modules numba imports later are changed by the next
     call: the engine calls it before and after each compile)."""
     count = 0
-    for name, module in list(sys.modules.items()):
+    for name, module in loaded_modules():
         if (name == "numba" or name.startswith("numba.")) and getattr(
             module, "__dict__", {}
         ).get("warnings") is _warnings:

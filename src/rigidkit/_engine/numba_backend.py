@@ -468,6 +468,8 @@ def _plain_errors():
     set before numba's import turns the colours off; when numba was imported
     earlier (by the user), its scheme is replaced here.
     """
+    from .compile_warnings import loaded_modules
+
     try:
         from numba.core import errors
     except Exception:  # pragma: no cover - numba's layout changed: nothing to undo
@@ -477,7 +479,7 @@ def _plain_errors():
     # Modules that numba imported meanwhile keep the scheme of their import time
     # (``_termcolor = errors.termcolor()`` in numba.core.types.functions, ir,
     # typing.typeof, compiler_machinery): the one that formats typing errors.
-    for name, module in list(sys.modules.items()):
+    for name, module in loaded_modules():
         if name.startswith("numba.") and type(
             getattr(module, "_termcolor", None)
         ).__name__ not in ("NoneType", "NOPColorScheme", "_PlainErrors"):
