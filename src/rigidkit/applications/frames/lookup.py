@@ -184,15 +184,21 @@ def _compose_blocks(items_s, items_t, q, interpolation, extrapolate):
     items_s, items_t = fold_left(items_s, m), fold_left(items_t, m)
     items = items_s + items_t
     times = [None if type(it) is Transform else it.check(q, extrapolate) for it in items]
+    # Where each segment's times begin, once for the call (times in order only)
+    spans = [
+        None if tk is None or interpolation != "decoupled" else it.bounds(tk)
+        for it, tk in zip(items, times)
+    ]
     out = np.empty((m, 7))
     ns = len(items_s)
     last = len(items) - 1 if not items_t else None
     for lo in range(0, m, BLOCK):
         hi = min(lo + BLOCK, m)
         chains = [None, None]
-        for k, (it, tk) in enumerate(zip(items, times)):
+        for k, (it, tk, ends) in enumerate(zip(items, times, spans)):
             if tk is not None:
-                it = it.at(tk[lo:hi], interpolation, many=m)[0]
+                span = None if ends is None else (ends, lo)
+                it = it.at(tk[lo:hi], interpolation, many=m, span=span)[0]
             c = 0 if k < ns else 1
             if k == last and chains[0] is not None:
                 # target is an ancestor of source: the last compose writes the rows
