@@ -180,7 +180,7 @@ class Snapshot:
             ends = self.bounds(q)
             return None if ends is None else ends[1:] - ends[:-1]
         ends, lo = span
-        ends = np.clip(ends, lo, lo + q.shape[0])
+        ends = np.minimum(np.maximum(ends, lo), lo + q.shape[0])  # np.clip: 3x slower
         return ends[1:] - ends[:-1]
 
     def rows(self, q, span=None):
