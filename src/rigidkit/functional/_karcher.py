@@ -11,6 +11,7 @@ mean frozen once converged. The group enters through its steps
 
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 
@@ -47,14 +48,17 @@ def karcher(xp, mean, g, w, total, method, tol, max_iter, steps):
 
 
 def karcher_traced(xp, mean, g, w, total, tol, max_iter, steps):
-    """The Karcher iteration without reading values: ``max_iter`` steps, each mean
-    frozen (``where``) once its own step is below ``tol``, as the eager loop stops.
+    """The Karcher iteration without reading values: each mean frozen (``where``)
+    once its own step is below ``tol``, as the eager loop stops.
 
-    On JAX one ``lax.fori_loop`` (a scan: the body traced once, reverse-mode
-    differentiable); elsewhere (torch.compile, torch.func) the steps unrolled.
-    ``iterations`` is then an array: the most steps any mean took (a mean that
-    never converged is not reported under tracing).
+    On JAX a ``lax.while_loop`` that stops when every mean has converged (or at
+    ``max_iter``), differentiated implicitly (:func:`_karcher_jax`); elsewhere
+    (torch.compile, torch.func) ``max_iter`` steps unrolled, differentiated
+    through. ``iterations`` is then an array: the most steps any mean took (a
+    mean that never converged is not reported under tracing).
     """
+    if type(g).__module__.startswith("jax"):
+        return _karcher_jax(xp, mean, g, w, total, tol, max_iter, steps)
     log_from, retract = steps
     tol2 = tol * tol
 
@@ -69,15 +73,85 @@ def karcher_traced(xp, mean, g, w, total, tol, max_iter, steps):
 
     first = mean[..., 0]
     state = (mean, first != first, 0.0 * first)  # not done (NaN aside), 0 steps
-    if type(g).__module__.startswith("jax"):
-        import jax
-
-        mean, _, count = jax.lax.fori_loop(0, max_iter, body, state)
-    else:
-        for i in range(max_iter):
-            state = body(i, state)
-        mean, _, count = state
+    for i in range(max_iter):
+        state = body(i, state)
+    mean, _, count = state
     return mean, xp.max(count)
+
+
+def _karcher_jax(xp, mean, g, w, total, tol, max_iter, steps):
+    """:func:`karcher_traced` on JAX: the fixed point found without derivatives,
+    differentiated implicitly (the implicit function theorem).
+
+    The iteration is a ``lax.while_loop``, so it stops when every mean has
+    converged (a handful of steps, not ``max_iter``), and nothing differentiates
+    through it (a while loop has no reverse mode; a scan of ``max_iter`` steps
+    had, at ``max_iter`` steps' cost). Its derivative is a ``custom_jvp``: the
+    mean ``mu`` solves ``F(mu, X, w) = sum w_i log(mu^-1 X_i) / sum w_i = 0``, so
+    a tangent ``dX, dw`` moves it by ``mu exp(delta)`` with ``H delta = -dF``,
+    ``H = dF(mu exp(delta))/d delta`` at 0 (forward mode, one column a tangent
+    direction) and ``dF`` the derivative of ``F`` along ``dX, dw`` at fixed
+    ``mu``. Linear in the tangents, so reverse mode transposes it. Exact at the
+    fixed point; at the converged iterate (mean log below ``tol``) to first order
+    in what is left of the mean log. ``H`` is formed only when derivatives are
+    taken: ``jit`` of the mean alone compiles the loop only.
+    """
+    import jax
+    import jax.numpy as jnp
+
+    log_from, retract = steps
+    tol2 = tol * tol
+
+    def residual(mu, g, w, total):
+        return _average(xp, log_from(mu, g), w, total)
+
+    def solve(mu, g, w, total):
+        def body(state):
+            mu, done, count, i = state
+            step = residual(mu, g, w, total)
+            new = retract(mu, step)
+            mu = xp.where(done[..., None], mu, new)
+            count = count + xp.where(done, 0.0 * count, 1.0 + 0.0 * count)
+            done = done | (xp.sum(step * step, axis=-1) <= tol2)
+            return mu, done, count, i + 1
+
+        def more(state):
+            return (state[3] < max_iter) & ~jnp.all(state[1])
+
+        first = mu[..., 0]
+        state = (mu, first != first, 0.0 * first, 0)  # not done (NaN aside), 0 steps
+        mu, _, count, _ = jax.lax.while_loop(more, body, state)
+        return mu, count
+
+    @jax.custom_jvp
+    def fixed_point(mu0, g, w, total):
+        return solve(mu0, g, w, total)
+
+    @fixed_point.defjvp
+    def fixed_point_jvp(primals, tangents):
+        mu0, g, w, total = primals
+        _, dg, dw, dtotal = tangents
+        mu, count = solve(mu0, g, w, total)
+        F = functools.partial(residual, mu)
+        dF = jax.jvp(F, (g, w, total), (dg, dw, dtotal))[1]
+        zero = jnp.zeros_like(dF)
+
+        def column(direction):  # H's column along one tangent direction
+            moved = functools.partial(retract, mu)
+            return jax.jvp(
+                lambda d: residual(moved(d), g, w, total),
+                (zero,),
+                (jnp.broadcast_to(direction, zero.shape),),
+            )[1]
+
+        basis = jnp.eye(dF.shape[-1], dtype=dF.dtype)
+        H = jax.vmap(column, out_axes=-1)(basis)  # the directions in one pass
+        delta = -jnp.linalg.solve(H, dF[..., None])[..., 0]
+        dmu = jax.jvp(functools.partial(retract, mu), (zero,), (delta,))[1]
+        return (mu, count), (dmu, jnp.zeros_like(count))
+
+    mu, count = fixed_point(mean, g, w, total)
+    return mu, xp.max(count)
 
 
 def lie_steps(compose, inverse, exp, log):
