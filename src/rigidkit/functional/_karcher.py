@@ -59,24 +59,24 @@ def karcher_traced(xp, mean, g, w, total, tol, max_iter, steps):
     """
     if type(g).__module__.startswith("jax"):
         return _karcher_jax(xp, mean, g, w, total, tol, max_iter, steps)
-    log_from, retract = steps
-    tol2 = tol * tol
-
-    def body(_, state):
-        mean, done, count = state
-        step = _average(xp, log_from(mean, g), w, total)
-        new = retract(mean, step)
-        mean = xp.where(done[..., None], mean, new)
-        count = count + xp.where(done, 0.0 * count, 1.0 + 0.0 * count)
-        done = done | (xp.sum(step * step, axis=-1) <= tol2)
-        return mean, done, count
-
     first = mean[..., 0]
     state = (mean, first != first, 0.0 * first)  # not done (NaN aside), 0 steps
-    for i in range(max_iter):
-        state = body(i, state)
+    for _ in range(max_iter):
+        state = _frozen_step(xp, steps, g, w, total, tol * tol, state)
     mean, _, count = state
     return mean, xp.max(count)
+
+
+def _frozen_step(xp, steps, g, w, total, tol2, state):
+    """One Karcher step of ``(mean, done, count)``: each mean moves and counts the
+    step until its own step is below ``sqrt(tol2)``, then stays (``where``)."""
+    log_from, retract = steps
+    mean, done, count = state
+    step = _average(xp, log_from(mean, g), w, total)
+    mean = xp.where(done[..., None], mean, retract(mean, step))
+    count = count + xp.where(done, 0.0 * count, 1.0 + 0.0 * count)
+    done = done | (xp.sum(step * step, axis=-1) <= tol2)
+    return mean, done, count
 
 
 def _karcher_jax(xp, mean, g, w, total, tol, max_iter, steps):
@@ -100,20 +100,14 @@ def _karcher_jax(xp, mean, g, w, total, tol, max_iter, steps):
     import jax.numpy as jnp
 
     log_from, retract = steps
-    tol2 = tol * tol
 
     def residual(mu, g, w, total):
         return _average(xp, log_from(mu, g), w, total)
 
     def solve(mu, g, w, total):
         def body(state):
-            mu, done, count, i = state
-            step = residual(mu, g, w, total)
-            new = retract(mu, step)
-            mu = xp.where(done[..., None], mu, new)
-            count = count + xp.where(done, 0.0 * count, 1.0 + 0.0 * count)
-            done = done | (xp.sum(step * step, axis=-1) <= tol2)
-            return mu, done, count, i + 1
+            *state, i = state
+            return (*_frozen_step(xp, steps, g, w, total, tol * tol, state), i + 1)
 
         def more(state):
             return (state[3] < max_iter) & ~jnp.all(state[1])
