@@ -73,3 +73,40 @@ def test_plain_object_matmul_breaks_fullgraph(case):
     match = "as_proxy" if case == "object @ tensor" else "builtin operator `matmul`"
     with pytest.raises(Exception, match=match):
         torch.compile(f, fullgraph=True, backend="eager")(s, v)
+
+
+def test_power_and_scalar_operators_with_a_tensor_trace_under_fullgraph():
+    """``R ** t``, ``T ** t``, ``s * q``, ``q * s`` and ``q / s`` with tensor ``t``
+    and ``s``: dynamo hands them to ``__torch_function__`` as torch's ``__rpow__``,
+    ``mul`` and ``__rtruediv__``/``div`` (which returned ``NotImplemented``: "All
+    __torch_function__ overrides returned NotImplemented", "Missing as_proxy()").
+    References: scipy's ``R ** t``, ``T ** t`` as ``exp(t log T)`` by
+    ``scipy.linalg.expm``/``logm``, and the componentwise scalar products."""
+    from scipy.linalg import expm, logm
+
+    t, s = 0.35, -1.75
+    q = np.array([0.5, -1.0, 2.0, 0.25])
+    T = rk.Transform.exp(np.array([0.4, -0.2, 0.9, 0.3, -1.1, 0.6]))
+
+    def f(r, x, q, t, s):
+        Q = rk.Quaternion(q)
+        return (
+            (rk.Rotation.from_rotvec(r) ** t).as_matrix(),
+            (rk.Transform.exp(x) ** t).as_matrix(),
+            (s * Q)._data,
+            (Q * s)._data,
+            (Q / s)._data,
+        )
+
+    args = [torch.as_tensor(np.asarray(a)) for a in (R_VEC, T.log(), q, t, s)]
+    got = torch.compile(f, fullgraph=True, backend="eager")(*args)
+    want = (
+        (SciRotation.from_rotvec(R_VEC) ** t).as_matrix(),
+        expm(t * logm(T.as_matrix())).real,
+        s * q,
+        q * s,
+        q / s,
+    )
+    for g, w in zip(got, want):
+        assert isinstance(g, torch.Tensor)
+        np.testing.assert_allclose(g.numpy(), w, rtol=0, atol=1e-12)

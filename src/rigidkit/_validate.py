@@ -38,6 +38,7 @@ from ._raising import (  # noqa: F401  (re-exported: callers import checks from 
     batch_index,
     checks_now,
     concrete,
+    dynamo_traces,
     raise_unless,
     raise_where,
     set_validation,
@@ -89,7 +90,11 @@ def as_array(x, trail: tuple, what: str):
             return _plain_scalar(x, trail, what)  # cannot read a traced ndarray's dtype)
         else:
             x = np.asarray(x)
-    if isinstance(x, np.ndarray) and x.dtype.kind not in "fiu":
+    if (
+        isinstance(x, np.ndarray)
+        and not _raising._COMPILER._is_compiling_flag
+        and x.dtype.kind not in "fiu"
+    ):
         raise ShapeError(f"{what}: expected real numbers, got dtype {x.dtype}")
     nt = len(trail)
     shape = tuple(x.shape)
@@ -171,7 +176,7 @@ def check_finite(x, trail: tuple, what: str) -> None:
     if not _raising._ENABLED:
         return
     if isinstance(x, np.ndarray):
-        if x.dtype.kind != "f":
+        if _raising._COMPILER._is_compiling_flag or x.dtype.kind != "f":
             return
         # A quick test that never passes a NaN or an infinity, before the exact one.
         # 0-d: one float conversion (50 ns). Up to 64 components a Python sum is
@@ -229,7 +234,11 @@ def finite_array(x, trail: tuple, what: str):
 
 def as_float(a):
     """Integer NumPy input becomes float64; other arrays are kept."""
-    if isinstance(a, np.ndarray) and a.dtype.kind != "f":
+    if (
+        isinstance(a, np.ndarray)
+        and not _raising._COMPILER._is_compiling_flag
+        and a.dtype.kind != "f"
+    ):
         return a.astype(np.float64)
     return a
 

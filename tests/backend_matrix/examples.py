@@ -436,9 +436,12 @@ ex(
     Q(4),
 )
 na_all(_p + "create_group", "builds a finite group from its name (a string)")
+# Made once, outside the transforms, as a symmetry group is: under torch.compile,
+# create_group's NumPy (a search for distinct elements) would be traced too.
+_C3 = rot.create_group("C3")
 ex(
     _p + "reduce",
-    lambda q: R_(q).reduce(rot.create_group("C3")).as_quat(canonical=True),
+    lambda q: R_(q).reduce(_C3).as_quat(canonical=True),
     Q(),
     na=no_grad("piecewise constant choice of the group element"),
 )

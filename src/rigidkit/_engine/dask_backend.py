@@ -50,8 +50,8 @@ _LETTERS = "abcdefghijklmnopqrstuvwxy"  # batch axes, then trailing ones; "z" is
 
 def is_dask(x) -> bool:
     """Whether ``x`` is a Dask collection (checked by module name: no import)."""
-    if isinstance(x, (float, int)):  # TorchDynamo cannot read a builtin's __module__
-        return False
+    if isinstance(x, (float, int, list, tuple)):  # TorchDynamo cannot read a builtin's
+        return False  # __module__
     return type(x).__module__.startswith("dask")
 
 

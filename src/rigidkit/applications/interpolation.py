@@ -135,6 +135,8 @@ def keyframe_times(times, count, what="keyframes"):
         raise ShapeError(f"times: expected a 1-D array, got shape {t.shape}")
     if t.shape[0] != count:
         raise ShapeError(f"times: {t.shape[0]} times for {count} {what}")
+    if not checks_now(t):  # traced by torch.compile: the values are not readable
+        return t
     bad = np.flatnonzero(np.diff(t) <= 0.0)
     if bad.size:
         k = int(bad[0]) + 1
@@ -158,12 +160,11 @@ def query_times(times, lo, hi, *, extrapolate=False):
     q = as_float(finite_array(times, (), "times"))
     if extrapolate:
         return q
-    lo, hi = float(lo), float(hi)
-    if checks_now(q):
-        _check_range(np.asarray(to_numpy(q)), lo, hi)
+    if checks_now(q) and checks_now(lo):
+        _check_range(np.asarray(to_numpy(q)), float(lo), float(hi))
     elif validation_enabled() and dask_backend.is_dask(q):
         # at compute time, per chunk, in whatever is computed from the times
-        dask_backend.defer(_check_range, (q,), (lo, hi), _relabel)
+        dask_backend.defer(_check_range, (q,), (float(lo), float(hi)), _relabel)
     return q
 
 

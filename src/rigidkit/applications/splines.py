@@ -129,13 +129,15 @@ class RotationSpline(_Spline):
             raise TypeError(
                 "RotationSpline interpolates a Rotation; use BSplineSE3 for poses"
             )
-        self.times = keyframe_times(times, len(rotations), "rotations")
-        self.rotations = rotations
+        knots = keyframe_times(times, len(rotations), "rotations")
+        # Solved before the first attribute is set: inside torch.compile the solve
+        # is a while_loop, and TorchDynamo (torch 2.13) loses an attribute set
+        # after one on an object whose attributes were set before it.
+        coeffs, iterations = _fs.rotation_spline_coefficients(knots, stored(rotations))
+        self.times, self.rotations = knots, rotations
         self.extrapolate = bool(extrapolate)
-        self.t_min, self.t_max = float(self.times[0]), float(self.times[-1])
-        self._coeffs, self.iterations = _fs.rotation_spline_coefficients(
-            self.times, stored(rotations)
-        )
+        self.t_min, self.t_max = float(knots[0]), float(knots[-1])
+        self._coeffs, self.iterations = coeffs, iterations
 
     def _eval(self, flat, order):
         return _fs.rotation_spline_eval(

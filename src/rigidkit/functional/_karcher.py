@@ -17,6 +17,7 @@ import warnings
 
 import numpy as np  # noqa: F401  (the doctests' namespace)
 
+from .._engine.traced_loops import compiled_while, needs_grad, torch_compiling
 from .._validate import concrete, to_numpy, tolerances
 from ..errors import ConvergenceWarning
 
@@ -59,11 +60,32 @@ def karcher_traced(xp, mean, g, w, total, tol, max_iter, steps):
     """
     if type(g).__module__.startswith("jax"):
         return _karcher_jax(xp, mean, g, w, total, tol, max_iter, steps)
+    if torch_compiling(mean, g) and not needs_grad(mean, g, w, total):
+        return _karcher_torch_while(xp, mean, g, w, total, tol, max_iter, steps)
     first = mean[..., 0]
     state = (mean, first != first, 0.0 * first)  # not done (NaN aside), 0 steps
     for _ in range(max_iter):
         state = _frozen_step(xp, steps, g, w, total, tol * tol, state)
     mean, _, count = state
+    return mean, xp.max(count)
+
+
+def _karcher_torch_while(xp, mean, g, w, total, tol, max_iter, steps):
+    """:func:`karcher_traced` inside ``torch.compile`` without gradients: one
+    ``while_loop`` node that stops when every mean has converged (the unrolled
+    ``max_iter`` steps took Inductor 750 s to compile)."""
+    first = mean[..., 0]
+    zero = 0.0 * xp.max(first)  # a 0-d step counter of the dtype and device
+
+    def more(mean, done, count, i):
+        return (i < max_iter) & ~xp.all(done)
+
+    def body(mean, done, count, i):
+        state = _frozen_step(xp, steps, g, w, total, tol * tol, (mean, done, count))
+        return (*state, i + 1.0)
+
+    state = (mean, first != first, 0.0 * first, zero)  # not done (NaN aside), 0 steps
+    mean, _, count, _ = compiled_while(more, body, state)
     return mean, xp.max(count)
 
 

@@ -127,7 +127,7 @@ def _grouped(xp, x, axes, trail):
     order = tuple(keep) + tuple(axes) + tuple(range(nb, x.ndim))
     y = _permute(xp, x, order)
     kept = tuple(x.shape[a] for a in keep)
-    k = math.prod(x.shape[a] for a in axes)
+    k = math.prod([x.shape[a] for a in axes])  # a list: Dynamo traces no generator here
     return xp.reshape(y, kept + (k,) + tuple(x.shape[nb:])), kept
 
 

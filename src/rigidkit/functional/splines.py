@@ -43,6 +43,7 @@ import numpy as np
 
 from .._engine import dask_backend
 from .._engine.namespace import device_of, namespace_of
+from .._engine.traced_loops import compiled_while, torch_compiling
 from .._validate import concrete, tolerances
 from ..errors import ConvergenceWarning
 from ..kernels import quaternion as _kq
@@ -237,9 +238,11 @@ def _newton_traced(xp, params, w, rates, done, max_iter):
     on values cut from the gradient (``stop_gradient``), then one more Newton step
     on the live equations: at the solution that step's derivative is the
     implicit one, ``-F_w^-1 dF`` (the implicit function theorem; Newton's step
-    at a root), so ``grad`` needs no differentiation of the loop. Elsewhere
-    (torch.func, torch.compile) ``max_iter`` steps unrolled, each spline's rates
-    frozen (``where``) from the step that meets the eager test on.
+    at a root), so ``grad`` needs no differentiation of the loop. Inside
+    ``torch.compile`` the same with torch's ``while_loop``
+    (:mod:`rigidkit._engine.traced_loops`). Under torch.func ``max_iter`` steps
+    unrolled, each spline's rates frozen (``where``) from the step that meets the
+    eager test on.
     """
     zero = 0.0 * xp.max(xp.abs(rates))
     state = (w, zero != zero, zero + math.inf, zero)  # not stopped (NaN aside)
@@ -258,10 +261,31 @@ def _newton_traced(xp, params, w, rates, done, max_iter):
         w, _, _, count = jax.lax.while_loop(go, step, (w0,) + state[1:])
         w = _newton_step(xp, params, jax.lax.stop_gradient(w))[0]
         return w, count
+    if torch_compiling(w):  # the same: torch's while_loop node (it has no backward)
+        fixed, w0, cut = _detached((params, w, rates))
+        scale = xp.max(xp.abs(cut))
+
+        def go(*state):
+            return ~state[1] & (state[3] < max_iter)
+
+        def step(*state):
+            return _newton_update(xp, fixed, done, scale, state, freeze=False)
+
+        w, _, _, count = compiled_while(go, step, (w0,) + state[1:])
+        return _newton_step(xp, params, w)[0], count
     scale = xp.max(xp.abs(rates))
     for _ in range(max_iter):
         state = _newton_update(xp, params, done, scale, state, freeze=True)
     return state[0], state[3]
+
+
+def _detached(x):
+    """Tensors (in nested tuples) cut from autograd's graph, as copies: the
+    while_loop node refuses inputs that alias each other (the end rates are views
+    of one tensor)."""
+    if isinstance(x, (tuple, list)):
+        return type(x)(_detached(a) for a in x)
+    return x.detach().clone()
 
 
 def _newton_update(xp, params, done, scale, state, freeze):

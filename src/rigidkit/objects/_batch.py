@@ -215,6 +215,53 @@ def _wrap_both(storage: str):
     return _wrap
 
 
+def compiled_operator(cls, func, args, kwargs):
+    """An operator between an object of ``cls`` and a tensor as TorchDynamo calls it.
+
+    TorchDynamo (torch 2.13) does not call an object's operator method when the
+    other operand is a tensor: it makes the operator torch's (``matmul``,
+    ``__rpow__``, ``mul``, ``__rtruediv__``...) and, since an object is no graph
+    value, fails ("Missing as_proxy() implementation") unless an operand defines
+    ``__torch_function__``, which it then calls. While compiling, this finds the
+    object's own method for ``func`` and calls it with the tensor (``X @ p``,
+    ``X ** t``, ``s * q``, ``q / s``); anything else, and every call outside
+    compilation, is ``NotImplemented``, so eager operators are unchanged.
+    """
+    if kwargs or len(args) != 2:
+        return NotImplemented
+    import torch
+
+    if not torch.compiler.is_compiling():
+        return NotImplemented
+    ours = [isinstance(a, cls) for a in args]
+    if ours[0] == ours[1]:
+        return NotImplemented
+    name = _OPERATOR_METHODS.get((getattr(func, "__name__", None), ours[1]))
+    if name is None:
+        return NotImplemented
+    obj, tensor = (args[1], args[0]) if ours[1] else args
+    return getattr(obj, name)(tensor)
+
+
+# (name of the torch function, object second) -> the object's method of equal value:
+# Dynamo swaps X @ p into matmul(p, X); s * X is mul(s, X); X ** t is t.__rpow__(X).
+_OPERATOR_METHODS = {
+    ("matmul", True): "__matmul__",
+    ("__matmul__", True): "__matmul__",
+    ("mul", True): "__rmul__",
+    ("__mul__", True): "__rmul__",
+    ("mul", False): "__mul__",
+    ("__mul__", False): "__mul__",
+    ("__rmul__", True): "__mul__",
+    ("__rpow__", True): "__pow__",
+    ("__rtruediv__", True): "__truediv__",
+    ("__rdiv__", True): "__truediv__",
+    ("div", False): "__truediv__",
+    ("__truediv__", False): "__truediv__",
+    ("true_divide", False): "__truediv__",
+}
+
+
 class BatchedArray:
     """Mixin: a batch of elements stored in one array of shape ``batch + _trail``.
 

@@ -29,7 +29,7 @@ from abc import ABC, abstractmethod
 
 from .._engine import owned_function
 from . import ladder, registry
-from ._batch import storage_slots
+from ._batch import compiled_operator, storage_slots
 
 __all__ = ["Group", "LieGroup"]
 
@@ -133,27 +133,16 @@ class Group(ABC):
 
     @classmethod
     def __torch_function__(cls, func, types, args=(), kwargs=None):
-        """``X @ tensor`` inside ``torch.compile``; nothing anywhere else.
+        """``X @ tensor`` and ``X ** tensor`` inside ``torch.compile``; nothing else.
 
-        TorchDynamo (torch 2.13) does not call ``__matmul__`` for an ``@`` whose
-        other operand is a tensor: it makes it torch's ``matmul`` and, since an
-        object is no graph value, fails ("Missing as_proxy() implementation")
-        unless an operand has this protocol, which it then calls with the
-        operands swapped to put the tensor first: ``(p, X)``. So while compiling,
-        ``(p, X)`` under ``matmul`` is ``X @ p`` (``X.__matmul__(p)``, traced as
-        ``X.apply(p)``). Dynamo swaps ``p @ X`` the same way, so a compiled
-        ``p @ X`` gives ``X @ p`` too, where eager code raises ``TypeError``
-        (``tests/test_torch_matmul.py`` holds both). Eager, every torch function
-        of an object returns ``NotImplemented`` here: ``p @ X`` reaches
-        :meth:`__rmatmul__` as before.
+        TorchDynamo makes them torch's ``matmul`` and ``__rpow__`` and calls this
+        (:func:`~rigidkit.objects._batch.compiled_operator`). It swaps ``p @ X`` into
+        the same call as ``X @ p``, so a compiled ``p @ X`` gives ``X @ p``, where
+        eager code raises ``TypeError`` (``tests/test_torch_matmul.py`` holds both).
+        Eager, every torch function of an object returns ``NotImplemented`` here:
+        ``p @ X`` reaches :meth:`__rmatmul__` as before.
         """
-        if not kwargs and len(args) == 2 and isinstance(args[1], Group):
-            import torch
-
-            if func in (torch._C.TensorBase.matmul, torch.Tensor.__matmul__):
-                if torch.compiler.is_compiling() and not isinstance(args[0], Group):
-                    return args[1].__matmul__(args[0])
-        return NotImplemented
+        return compiled_operator(Group, func, args, kwargs)
 
     @classmethod
     def include(cls, x):
@@ -228,8 +217,9 @@ class LieGroup(Group):
 
         cls = type(self)
         wrap = cls._wrap
+        # compose, not @: TorchDynamo (torch 2.13) traces no @ between two objects
         steps = lie_steps(
-            lambda a, b: (wrap(a) @ wrap(b))._data,
+            lambda a, b: wrap(a).compose(wrap(b))._data,
             lambda a: wrap(a).inv()._data,
             lambda tau: cls.exp(tau)._data,
             lambda a: wrap(a).log(),

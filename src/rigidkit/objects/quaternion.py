@@ -25,7 +25,7 @@ from .._engine.dask_backend import is_dask
 from .._engine.namespace import is_numpy, namespace_of
 from .._validate import as_array, check_finite, to_numpy
 from ..functional import quaternion as _fq
-from ._batch import BatchedArray
+from ._batch import BatchedArray, compiled_operator
 from ._frozen import frozen, owned
 from .rotation import Rotation
 
@@ -63,6 +63,12 @@ class Quaternion(BatchedArray):
     _repr_columns = "(w, x, y, z)"
     # NumPy's binary operators defer to ours (ndarray * Quaternion -> __rmul__).
     __array_ufunc__ = None
+
+    @classmethod
+    def __torch_function__(cls, func, types, args=(), kwargs=None):
+        """``s * q``, ``q * s`` and ``q / s`` with a tensor ``s`` inside ``torch.compile``
+        (:func:`~rigidkit.objects._batch.compiled_operator`); nothing anywhere else."""
+        return compiled_operator(Quaternion, func, args, kwargs)
 
     def __init__(self, components):
         q = _fq._quat(components, "quaternion components")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..._engine.namespace import is_torch, namespace_of
-from ..._validate import checks_now, concrete, to_numpy
+from ..._validate import checks_now, concrete, dynamo_traces, to_numpy
 from ...errors import OutOfRangeError, ShapeError, TimestampError
 from ...objects._batch import expect
 from ...objects.similarity import Similarity
@@ -81,8 +81,9 @@ def check_stamps(stamps, n: int, what: str = "stamps"):
     t = np.array(stamps, dtype=np.float64)  # a copy: the caller keeps its array
     if t.shape != (n,):
         raise ShapeError(f"{what} must have shape ({n},) (one per pose), got {t.shape}")
-    _check_values(t, what)
-    t.flags.writeable = False
+    if not dynamo_traces():  # while torch.compile traces, NumPy is a graph value
+        _check_values(t, what)
+        t.flags.writeable = False
     return t
 
 
