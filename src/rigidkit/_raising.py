@@ -22,7 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._engine import dask_backend, post_import
+from ._engine import dask_backend
+from ._engine import namespace as _ns
 from ._engine.namespace import is_torch, namespace_of
 
 # -- when values can be checked: concreteness and the validation switch ---------------
@@ -80,7 +81,7 @@ def concrete(x) -> bool:
     """
     t = type(x)
     if t is _NDARRAY:
-        return not _COMPILER._is_compiling_flag
+        return not _ns.COMPILER._is_compiling_flag
     if t in _CONCRETE_TYPES:
         return True
     module = t.__module__
@@ -119,47 +120,12 @@ def checks_now(x) -> bool:
 def dynamo_traces() -> bool:
     """Whether TorchDynamo is tracing the caller (``torch.compile``).
 
-    Dynamo traces NumPy code too: an ``ndarray`` made or passed inside a compiled
-    function is a graph value there, whose values cannot be read without breaking
-    the graph, and whose ``dtype`` torch 2.13's Dynamo cannot trace at all
-    ("Unsupported ndarray attribute access"). So the checks of NumPy input that read
-    either are skipped while this is true, as for any traced array. Hot paths read
-    ``_COMPILER._is_compiling_flag`` themselves (two attribute reads, ~20 ns; a call
-    of ``torch.compiler.is_compiling`` costs ~0.1 us).
+    Then NumPy input is a graph value too, whose values and dtype cannot be read:
+    the checks that read either skip it, as for any traced array (see
+    :data:`rigidkit._engine.namespace.COMPILER`; hot paths read its flag
+    themselves).
     """
-    return _COMPILER._is_compiling_flag
-
-
-class _NoCompiler:
-    """Stands for ``torch.compiler`` until torch is in use: nothing is compiling."""
-
-    _is_compiling_flag = False
-
-
-class _Compiler:
-    """``torch.compiler`` where it has no ``_is_compiling_flag`` (not torch 2.13)."""
-
-    @property
-    def _is_compiling_flag(self):
-        import torch
-
-        return torch.compiler.is_compiling()
-
-
-#: ``torch.compiler`` once torch is in use: its flag is true for the whole of a
-#: ``torch.compile`` session, so read eagerly and by Dynamo alike.
-_COMPILER = _NoCompiler
-
-
-def _bind_compiler():
-    global _COMPILER
-    import torch.compiler
-
-    has_flag = isinstance(getattr(torch.compiler, "_is_compiling_flag", None), bool)
-    _COMPILER = torch.compiler if has_flag else _Compiler()
-
-
-post_import.when_imported("torch", _bind_compiler)
+    return _ns.COMPILER._is_compiling_flag
 
 
 def _deferred(x) -> bool:

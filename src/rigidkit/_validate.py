@@ -29,6 +29,7 @@ import numpy as np
 
 from . import _raising
 from ._engine import dask_backend
+from ._engine import namespace as _ns
 from ._engine.namespace import is_numpy, namespace_of
 from ._raising import (  # noqa: F401  (re-exported: callers import checks from here)
     _deferred,
@@ -92,7 +93,7 @@ def as_array(x, trail: tuple, what: str):
             x = np.asarray(x)
     if (
         isinstance(x, np.ndarray)
-        and not _raising._COMPILER._is_compiling_flag
+        and not _ns.COMPILER._is_compiling_flag
         and x.dtype.kind not in "fiu"
     ):
         raise ShapeError(f"{what}: expected real numbers, got dtype {x.dtype}")
@@ -176,7 +177,7 @@ def check_finite(x, trail: tuple, what: str) -> None:
     if not _raising._ENABLED:
         return
     if isinstance(x, np.ndarray):
-        if _raising._COMPILER._is_compiling_flag or x.dtype.kind != "f":
+        if _ns.COMPILER._is_compiling_flag or x.dtype.kind != "f":
             return
         # A quick test that never passes a NaN or an infinity, before the exact one.
         # 0-d: one float conversion (50 ns). Up to 64 components a Python sum is
@@ -236,7 +237,7 @@ def as_float(a):
     """Integer NumPy input becomes float64; other arrays are kept."""
     if (
         isinstance(a, np.ndarray)
-        and not _raising._COMPILER._is_compiling_flag
+        and not _ns.COMPILER._is_compiling_flag
         and a.dtype.kind != "f"
     ):
         return a.astype(np.float64)

@@ -45,6 +45,8 @@ import weakref
 
 import numpy as np
 
+from . import namespace as _namespace
+
 _LETTERS = "abcdefghijklmnopqrstuvwxy"  # batch axes, then trailing ones; "z" is free
 
 
@@ -52,6 +54,8 @@ def is_dask(x) -> bool:
     """Whether ``x`` is a Dask collection (checked by module name: no import)."""
     if isinstance(x, (float, int, list, tuple)):  # TorchDynamo cannot read a builtin's
         return False  # __module__
+    if _namespace.COMPILER._is_compiling_flag:  # nor a class's; and Dask never traces
+        return False
     return type(x).__module__.startswith("dask")
 
 

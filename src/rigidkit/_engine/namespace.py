@@ -28,10 +28,40 @@ def _torch_namespace():
 
 
 def _set_torch_namespace():
-    global _TORCH_NS
+    global _TORCH_NS, COMPILER
     from .torch_setup import NAMESPACE
 
     _TORCH_NS = NAMESPACE
+    import torch.compiler
+
+    has_flag = isinstance(getattr(torch.compiler, "_is_compiling_flag", None), bool)
+    COMPILER = torch.compiler if has_flag else _Compiler()
+
+
+class _NoCompiler:
+    """Stands for ``torch.compiler`` until torch is in use: nothing is compiling."""
+
+    _is_compiling_flag = False
+
+
+class _Compiler:
+    """``torch.compiler`` where it has no ``_is_compiling_flag`` (not torch 2.13)."""
+
+    @property
+    def _is_compiling_flag(self):
+        import torch
+
+        return torch.compiler.is_compiling()
+
+
+#: ``torch.compiler`` once torch is in use, else a stand-in: its
+#: ``_is_compiling_flag`` is true for the whole of a ``torch.compile`` session, so
+#: it reads the same eagerly and to TorchDynamo. TorchDynamo traces NumPy code too:
+#: a NumPy array made or captured in a compiled function is a graph value, whose
+#: values cannot be read and whose ``dtype`` torch 2.13 cannot trace; code that
+#: reads either asks this first (two attribute reads, ~20 ns; a call of
+#: ``torch.compiler.is_compiling`` costs ~0.1 us, ``sys.modules`` is unsafe there).
+COMPILER = _NoCompiler
 
 
 post_import.when_imported("torch", _set_torch_namespace)
@@ -98,6 +128,8 @@ def float_dtype_of(xp, *arrays):
         if not np.issubdtype(dt, np.floating) or dt.itemsize > 8:
             return np.dtype(np.float64)
         return dt
+    if COMPILER._is_compiling_flag:  # a traced ndarray's dtype cannot be read
+        arrays = [a for a in arrays if type(a) is not np.ndarray]
     dts = [a.dtype for a in arrays if hasattr(a, "dtype")]
     f64 = xp.float64
     f32 = xp.float32

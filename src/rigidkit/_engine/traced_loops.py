@@ -40,9 +40,12 @@ def compiled_while(cond, body, state):
     """``while cond(*state): state = body(*state)`` as one graph node.
 
     ``state`` is a tuple of tensors whose shapes and dtypes the body keeps;
-    ``cond`` returns a 0-d boolean tensor. Only inside ``torch.compile``
+    ``cond`` returns a 0-d boolean tensor. Tensors the two functions capture
+    must not alias each other (copy them). Only inside ``torch.compile``
     (:func:`torch_compiling`).
     """
     from torch._higher_order_ops import while_loop
 
-    return tuple(while_loop(cond, body, tuple(state)))
+    # Copies: Inductor refuses a state that aliases the loop's other inputs (a
+    # mean started from a view of the data: "might be aliasing the input").
+    return tuple(while_loop(cond, body, tuple(s.clone() for s in state)))

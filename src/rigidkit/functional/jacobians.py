@@ -25,7 +25,7 @@ from functools import cache
 
 import numpy as np
 
-from .._engine.namespace import device_of, namespace_of
+from .._engine.namespace import device_of, is_numpy, namespace_of
 from .._validate import as_array, as_float
 
 __all__ = ["action_generator", "to_left"]
@@ -62,13 +62,18 @@ def action_generator(hat, dof, point_dim, points):
     """
     points = as_float(as_array(points, (point_dim,), "points"))
     xp = namespace_of(points)
-    rows = _generator_rows(hat, dof, point_dim)
-    H = xp.asarray(rows, dtype=points.dtype, device=device_of(points))
-    if rows.shape[-1] > point_dim:
+    if is_numpy(xp):
+        rows = _generator_rows(hat, dof, point_dim)
+        H = xp.asarray(rows, dtype=points.dtype)
+    else:  # made in the points' namespace: torch.compile would trace NumPy's making
+        eye = xp.asarray(np.eye(dof), dtype=points.dtype, device=device_of(points))
+        gens = hat(eye)
+        H = xp.stack([gens[:, i, :] for i in range(point_dim)], axis=0)
+    if H.shape[-1] > point_dim:
         # (p is finite; the torch adapter has no ones_like of a slice's shape)
         zero = points[..., :1] * 0.0
         # ``[p; 1]``, or ``[p; 0; 1]`` for SE_2(3), whose velocity column moves no point
-        pad = [zero] * (rows.shape[-1] - point_dim - 1)
+        pad = [zero] * (H.shape[-1] - point_dim - 1)
         points = xp.concat([points, *pad, zero + 1.0], axis=-1)
     return xp.matmul(H, points[..., None, :, None])[..., 0]
 

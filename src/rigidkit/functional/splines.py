@@ -46,6 +46,7 @@ from .._engine.namespace import device_of, namespace_of
 from .._engine.traced_loops import compiled_while, torch_compiling
 from .._validate import concrete, tolerances
 from ..errors import ConvergenceWarning
+from ..kernels import homogeneous as _kh
 from ..kernels import quaternion as _kq
 from ..kernels import se3 as _kse3
 from ..kernels import so3 as _kso3
@@ -81,20 +82,27 @@ def _solve_block_tridiagonal(xp, lower, diag, upper, rhs):
     so no pivoting is needed. One Python step per block row.
     """
     m = diag.shape[0]
-    d = [None] * m
+    d_inv = [None] * m
     r = [None] * m
-    d[0], r[0] = diag[0], rhs[0]
+    d_inv[0], r[0] = _inv3(xp, diag[0]), rhs[0]
     for e in range(1, m):
-        w = lower[e] @ xp.linalg.inv(d[e - 1])
-        d[e] = diag[e] - w @ upper[e - 1]
+        w = lower[e] @ d_inv[e - 1]
+        d_inv[e] = _inv3(xp, diag[e] - w @ upper[e - 1])
         r[e] = rhs[e] - _matvec(w, r[e - 1])
     x = [None] * m
-    x[m - 1] = xp.linalg.solve(d[m - 1], r[m - 1][..., None])[..., 0]
+    x[m - 1] = _matvec(d_inv[m - 1], r[m - 1])
     for e in range(m - 2, -1, -1):
-        x[e] = xp.linalg.solve(d[e], (r[e] - _matvec(upper[e], x[e + 1]))[..., None])[
-            ..., 0
-        ]
+        x[e] = _matvec(d_inv[e], r[e] - _matvec(upper[e], x[e + 1]))
     return xp.stack(x, axis=0)
+
+
+def _inv3(xp, a):
+    """Inverses of 3x3 blocks (..., 3, 3) by the adjugate of ``a / max|a_ij|``
+    (:func:`rigidkit.kernels.homogeneous.affine_inverse`), not ``linalg.inv``:
+    torch's checks its input for singularity as a side effect, which Inductor
+    cannot compile inside the Newton solve's while_loop (torch 2.13). The blocks
+    are diagonally dominant (above), so the adjugate loses nothing."""
+    return _kh.affine_inverse(xp.concat([a, a[..., :1] * 0.0], axis=-1))[0][..., :3]
 
 
 def _relative_rotvecs(quats):

@@ -23,6 +23,7 @@ order is permuted and the rotation error maps by ``phi = J_r(theta) dtheta``.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -343,7 +344,7 @@ def preintegrate(
         )
     )
     n = w.shape[-2]
-    windows = int(np.prod(batch, dtype=np.int64))
+    windows = math.prod(batch)  # not np.prod: torch.compile would trace it as an array
     if all(type(x) is np.ndarray for x in (w, f, h, bg, ba)):
         fold = _fold.ready(method, windows * n)
         if fold is not None:

@@ -108,7 +108,7 @@ def align(est, ref, method="se3", first=None):
             S = Transform.from_pq(np.broadcast_to(S.as_pq(), lead + (7,)))
         return est.transform(S) if lead else est, S
     if method == "origin":
-        S = ref.poses[..., 0] @ est.poses[..., 0].inv()
+        S = ref.poses[..., 0].compose(est.poses[..., 0].inv())  # @ would not compile
         return est.transform(S), S
     # The positions of the poses' namespace: on torch and JAX the fit, and the
     # transform it applies, are differentiable (the SVD of Umeyama's method, for

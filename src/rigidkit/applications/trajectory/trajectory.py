@@ -348,9 +348,10 @@ class Trajectory:
             )
         if not S.single:
             S = S.reshape(S.shape + (1,))
+        # compose, not @: TorchDynamo (torch 2.13) traces no @ between two objects
         if isinstance(S, Transform):
-            return Trajectory._trusted(self._stamps, S @ self._poses)
-        rotation = S.rotation @ self._poses.rotation
+            return Trajectory._trusted(self._stamps, S.compose(self._poses))
+        rotation = S.rotation.compose(self._poses.rotation)
         translation = S.apply(self.positions)
         return Trajectory._trusted(
             self._stamps, Transform(rotation=rotation, translation=translation)
