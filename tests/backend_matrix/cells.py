@@ -47,7 +47,9 @@ def leaves(out) -> list:
     if dataclasses.is_dataclass(out) and not isinstance(out, type):
         return leaves([getattr(out, f.name) for f in dataclasses.fields(out)])
     if hasattr(out, "__dict__") and type(out).__module__.startswith("rigidkit"):
-        return leaves([v for k, v in sorted(vars(out).items()) if not k.startswith("__")])
+        # sorted names, not (name, value) pairs: TorchDynamo cannot sort tensors
+        fields = vars(out)
+        return leaves([fields[k] for k in sorted(fields) if not k.startswith("__")])
     return [out]
 
 

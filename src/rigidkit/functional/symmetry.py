@@ -217,5 +217,12 @@ def quat_reduce(quat, left=None, right=None):
     best = xp.reshape(xp.abs(w), tuple(w.shape[:-2]) + (nl * nr,)).argmax(-1)
     li = best // nr
     ri = best % nr
-    reduced = _kq.quat_compose(_kq.quat_compose(L[li], q), R[ri])
+    reduced = _kq.quat_compose(_kq.quat_compose(_rows(xp, L, li), q), _rows(xp, R, ri))
     return reduced, li, ri
+
+
+def _rows(xp, table, idx):
+    """``table[idx]`` through a 1-D index: a 0-d tensor index would be read as a
+    Python int, which torch.compile cannot do with a traced value."""
+    flat = table[xp.reshape(idx, (-1,))]
+    return xp.reshape(flat, tuple(idx.shape) + tuple(table.shape[1:]))
