@@ -205,6 +205,22 @@ def test_knots_as_a_list_and_a_python_time_compile(keys, torch):
         assert np.allclose(g.numpy(), w, rtol=0, atol=1e-12)
 
 
+@pytest.mark.parametrize("method", ["slerp", "linear"])
+def test_trajectory_resampling_compiles_with_numpy_stamps(method, torch):
+    """``Trajectory(stamps, poses).at(times)`` inside torch.compile with NumPy stamps
+    and times (traced by Dynamo: their range check and ``np.shape`` read values)
+    and poses from a tensor; equals the NumPy call."""
+    x = np.random.default_rng(1).uniform(-0.5, 0.5, (6, 6))
+
+    def f(x):
+        traj = rk.Trajectory(np.arange(6) * 0.5, rk.Transform.exp(x))
+        return traj.at(np.array([0.2, 1.3, 2.5]), method=method).poses.as_matrix()
+
+    torch._dynamo.reset()
+    out = torch.compile(f, fullgraph=True, backend="eager")(torch.tensor(x))
+    assert np.allclose(out.numpy(), f(x), rtol=0, atol=1e-12)
+
+
 def test_interpolators_on_torch_keep_the_graph(keys, torch):
     """Torch query times: the result is a tensor, differentiable in the times."""
     times, rotations, _ = keys

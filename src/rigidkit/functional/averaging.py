@@ -309,8 +309,8 @@ def quat_mean_unchecked(
     The weights are still validated. :meth:`rigidkit.Rotation.mean` calls this.
     """
     if (
-        _GRAM is not None
-        and type(q) is np.ndarray
+        type(q) is np.ndarray  # first: TorchDynamo cannot guard on a numba dispatcher
+        and _GRAM is not None
         and weights is None
         and axis is None
         and method == "chordal"

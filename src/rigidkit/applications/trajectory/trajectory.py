@@ -288,7 +288,9 @@ class Trajectory:
             A time outside the stamps' range (the message names the range).
         """
         t = self._times()
-        n = np.shape(times)[0] if np.ndim(times) else -1
+        # .shape where there is one: np.shape of an array TorchDynamo traces is no int
+        shape = tuple(times.shape) if hasattr(times, "shape") else np.shape(times)
+        n = shape[0] if shape else -1
         q = host_stamps(check_stamps(times, n, "times"))
         if len(t) < 2:
             raise OutOfRangeError(f"interpolation needs at least 2 poses, got {len(t)}")
