@@ -252,9 +252,10 @@ def samples():
     return times, rotations, transforms, omega
 
 
-def _kinematics(times, rotations, transforms, omega):
+def _kinematics(times, rotations, transforms, omega, twists=None):
     """name -> (function of one array argument, its NumPy value)."""
     kin = rk.kinematics
+    twists = np.concatenate([omega, omega], -1) if twists is None else twists
     steps = np.diff(times, append=times[-1] + 0.1)
     return {
         "angular_velocity_from_samples": (
@@ -284,7 +285,7 @@ def _kinematics(times, rotations, transforms, omega):
         "integrate_twist-midpoint-steps": (
             lambda h: kin.integrate_twist(
                 transforms[0],
-                np.concatenate([omega, omega], -1),
+                twists,
                 h,
                 frame="body",
                 method="midpoint",
@@ -310,6 +311,25 @@ def test_kinematics_trace_under_jit(name, samples, jax, jnp, validation):
     fn, x = _kinematics(*samples)[name]
     out = jax.jit(fn)(jnp.asarray(x))
     assert np.allclose(np.asarray(out), fn(x), rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("name", KINEMATICS)
+def test_kinematics_compile_fullgraph(name, samples, torch):
+    """The same calls inside torch.compile(fullgraph=True), keyframes and samples
+    as tensors: they broke the graph on data-dependent branches (the step times, a
+    zero direction) and on ``str.startswith`` in the integrators."""
+    times, rotations, transforms, omega = samples
+    fn, x = _kinematics(*samples)[name]
+    on_torch = _kinematics(
+        times,
+        rk.Rotation.from_quat(torch.tensor(rotations.as_quat())),
+        rk.Transform.from_pq(torch.tensor(transforms.as_pq())),
+        torch.tensor(omega),
+        torch.tensor(np.concatenate([omega, omega], -1)),
+    )[name][0]
+    torch._dynamo.reset()
+    out = torch.compile(on_torch, fullgraph=True, backend="eager")(torch.tensor(x))
+    assert np.allclose(out.numpy(), fn(x), rtol=0, atol=1e-12)
 
 
 def test_rk4_gradient_in_the_steps(samples, jax, jnp):

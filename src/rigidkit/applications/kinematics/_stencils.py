@@ -31,8 +31,10 @@ def _node_offsets(d, m: int, xp=np):
     each step's window) depends on the shapes only and is NumPy.
     """
     n = d.shape[-1]
-    k = np.arange(n)
-    j0 = np.clip(k - (m // 2 - 1), 0, n - m)
+    # The shape-only bookkeeping in Python ints: torch.compile traces NumPy too, and
+    # np.unique's size would then depend on traced values.
+    starts = [min(max(k - (m // 2 - 1), 0), n - m) for k in range(n)]
+    j0 = np.array(starts, dtype=np.intp)
     lead = tuple(d.shape[:-1])
     pad = xp.zeros(lead + (m,), dtype=d.dtype, device=device_of(d))
     p = xp.concat([pad, d, pad], axis=-1)  # p[..., k + m + l] = d_{k+l}
@@ -43,12 +45,12 @@ def _node_offsets(d, m: int, xp=np):
         cols[m - 1 + s] = cols[m - 2 + s] + p[..., m + s - 1 : m + s - 1 + n]
         cols[m - 1 - s] = cols[m - s] - p[..., m - s : m - s + n]
     # column j0(k) + i - k of row k: a fixed (shape-only) selection
-    shift = j0 - k + (m - 1)  # (N,), the column of node i = 0
+    shift = [starts[k] - k + (m - 1) for k in range(n)]  # the column of node i = 0
     offs = []
     for i in range(m):
         col = 0.0 * d
-        for c in np.unique(shift + i):
-            mask = np.asarray(shift + i == c, dtype=np.float64)
+        for c in sorted({s + i for s in shift}):
+            mask = [1.0 if s + i == c else 0.0 for s in shift]
             col = col + _const(xp, mask, d) * cols[c]
         offs.append(col)
     return j0, xp.stack(offs, axis=-1)
