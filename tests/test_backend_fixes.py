@@ -205,7 +205,7 @@ def test_knots_as_a_list_and_a_python_time_compile(keys, torch):
         assert np.allclose(g.numpy(), w, rtol=0, atol=1e-12)
 
 
-@pytest.mark.parametrize("method", ["slerp", "linear"])
+@pytest.mark.parametrize("method", ["slerp", "linear", "spline"])
 def test_trajectory_resampling_compiles_with_numpy_stamps(method, torch):
     """``Trajectory(stamps, poses).at(times)`` inside torch.compile with NumPy stamps
     and times (traced by Dynamo: their range check and ``np.shape`` read values)

@@ -18,6 +18,7 @@ is required for orders 1 and 2.
 
 from __future__ import annotations
 
+from .._validate import dynamo_traces
 from ..errors import FrameKeywordError
 from ..functional import splines as _fs
 from ..objects import registry
@@ -181,7 +182,8 @@ class BSplineSO3(_Spline):
         if keyframe_kind(control_points, 4, "control_points") is not self.kind:
             raise TypeError(f"{type(self).__name__} needs a {self.kind.__name__}")
         dt, t0 = float(dt), float(t0)
-        if not dt > 0.0:
+        # (a dt made from NumPy stamps that torch.compile traces is a symbol then)
+        if not dynamo_traces() and not dt > 0.0:
             raise ValueError(f"dt must be positive, got {dt!r}")
         self.control_points = control_points
         self.dt, self.t0 = dt, t0

@@ -322,7 +322,9 @@ class Trajectory:
             ctrl = Transform.concatenate([ctrl[:1], ctrl, ctrl[-1:]])
             dt = (t[-1] - t[0]) / (len(t) - 1)
             spline = BSplineSE3(ctrl, dt=dt, t0=float(t[0]))
-            out = spline(np.minimum(q, spline.t_max))
+            # t_max may round below t[-1]; while torch.compile traces it is a symbol
+            # no array op takes, and the range check that needs the clamp is off
+            out = spline(np.minimum(q, t[-1] if dynamo_traces() else spline.t_max))
         else:
             raise ValueError(
                 f"method must be 'slerp', 'linear' or 'spline', got {method!r}"
