@@ -7,9 +7,7 @@ before compute), the masks' questions :func:`any_true` and :func:`all_true`, and
 element is raised, with its batch index as ``err.index``. The checks themselves
 are in :mod:`rigidkit._validate`, which re-exports all of these.
 
->>> import sys
-
-import numpy as np
+>>> import numpy as np
 >>> from rigidkit.errors import NonFiniteError
 >>> try:
 ...     raise_where(np.array([False, True]), NonFiniteError, "NaN {where}")
