@@ -14,6 +14,7 @@ outside it (the implicit derivative at the fixed point).
 
 from __future__ import annotations
 
+from . import namespace
 from .namespace import is_torch
 
 __all__ = ["compiled_while", "torch_compiling"]
@@ -25,10 +26,7 @@ def torch_compiling(*arrays) -> bool:
     for a in arrays:
         if not is_torch(a):
             return False
-    import torch  # imported: the arrays are tensors (no sys.modules read: Dynamo
-    # iterates that dictionary while the engine's thread may import)
-
-    return torch.compiler.is_compiling()
+    return namespace.COMPILER._is_compiling_flag
 
 
 def needs_grad(*arrays) -> bool:

@@ -229,7 +229,8 @@ def compiled_operator(cls, func, args, kwargs):
     """
     if kwargs or len(args) != 2:
         return NotImplemented
-    import torch
+    import torch  # (torch called this; namespace.COMPILER is bound only once a
+    # tensor has met the engine, and an object made from NumPy may meet one here)
 
     if not torch.compiler.is_compiling():
         return NotImplemented
