@@ -424,6 +424,25 @@ def test_geodesic_mean_under_torch_compile(spread, torch):
         assert np.allclose(got.numpy(), fn(x), rtol=0, atol=1e-12)
 
 
+def test_reduce_of_one_rotation_compiles(torch):
+    """``Rotation.reduce`` of a single rotation picks its group element with a 0-d
+    index tensor, which torch read as a data-dependent Python int: torch.compile
+    failed. The reference is scipy's ``reduce`` with the same group."""
+    from scipy.spatial.transform import Rotation as SciRotation
+
+    group = rk.Rotation.create_group("C3")
+    q = rk.Rotation.from_rotvec([0.4, -1.9, 2.2]).as_quat()
+
+    def f(q):
+        return rk.Rotation.from_quat(q).reduce(group).as_matrix()
+
+    torch._dynamo.reset()
+    got = torch.compile(f, fullgraph=True, backend="eager")(torch.tensor(q))
+    sci_group = SciRotation.from_quat(group.as_quat(), scalar_first=True)
+    want = SciRotation.from_quat(q, scalar_first=True).reduce(sci_group).as_matrix()
+    assert np.allclose(got.numpy(), want, rtol=0, atol=1e-12)
+
+
 @pytest.mark.parametrize(
     "kw, text",
     [

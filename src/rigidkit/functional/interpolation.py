@@ -257,9 +257,14 @@ def take_rows(x, idx):
     """``x[idx]`` along the first axis; ``idx`` an integer array of any namespace.
 
     NumPy ``x`` meets the namespace of ``idx`` first (a constant under ``jit``, a
-    one-chunk Dask array for Dask indices, a tensor on the device of ``idx``).
+    one-chunk Dask array for Dask indices, a tensor on the device of ``idx``). A
+    0-d index goes through one of shape (1,): torch reads a 0-d index tensor as a
+    Python int, a data-dependent one that ``torch.compile`` cannot make.
     """
-    return meet(x, idx)[idx]
+    x = meet(x, idx)
+    if getattr(idx, "ndim", None) == 0:
+        return x[idx[None]][0]
+    return x[idx]
 
 
 def meet(x, like):

@@ -36,6 +36,7 @@ from .._validate import _relabel, as_array
 from ..errors import RigidkitError
 from ..kernels import quaternion as _kq
 from .davenport import asarray_like
+from .interpolation import take_rows
 
 __all__ = ["quat_group", "quat_reduce"]
 
@@ -217,12 +218,5 @@ def quat_reduce(quat, left=None, right=None):
     best = xp.reshape(xp.abs(w), tuple(w.shape[:-2]) + (nl * nr,)).argmax(-1)
     li = best // nr
     ri = best % nr
-    reduced = _kq.quat_compose(_kq.quat_compose(_rows(xp, L, li), q), _rows(xp, R, ri))
+    reduced = _kq.quat_compose(_kq.quat_compose(take_rows(L, li), q), take_rows(R, ri))
     return reduced, li, ri
-
-
-def _rows(xp, table, idx):
-    """``table[idx]`` through a 1-D index: a 0-d tensor index would be read as a
-    Python int, which torch.compile cannot do with a traced value."""
-    flat = table[xp.reshape(idx, (-1,))]
-    return xp.reshape(flat, tuple(idx.shape) + tuple(table.shape[1:]))
