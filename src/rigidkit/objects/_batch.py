@@ -244,22 +244,15 @@ def compiled_operator(cls, func, args, kwargs):
     return getattr(obj, name)(tensor)
 
 
-# (name of the torch function, object second) -> the object's method of equal value:
-# Dynamo swaps X @ p into matmul(p, X); s * X is mul(s, X); X ** t is t.__rpow__(X).
+# (name of the torch function, object second) -> the object's method of equal value,
+# as TorchDynamo (torch 2.13) calls them: X @ p and p @ X as matmul(p, X), s * X as
+# mul(s, X), X ** t as t.__rpow__(X), X / s as s.__rdiv__(X) (torch's __rtruediv__);
+# X * s it hands to X.__mul__ itself. Each is held by a test (test_torch_matmul.py).
 _OPERATOR_METHODS = {
     ("matmul", True): "__matmul__",
-    ("__matmul__", True): "__matmul__",
     ("mul", True): "__rmul__",
-    ("__mul__", True): "__rmul__",
-    ("mul", False): "__mul__",
-    ("__mul__", False): "__mul__",
-    ("__rmul__", True): "__mul__",
     ("__rpow__", True): "__pow__",
-    ("__rtruediv__", True): "__truediv__",
     ("__rdiv__", True): "__truediv__",
-    ("div", False): "__truediv__",
-    ("__truediv__", False): "__truediv__",
-    ("true_divide", False): "__truediv__",
 }
 
 
