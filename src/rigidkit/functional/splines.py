@@ -46,10 +46,11 @@ from .._engine.namespace import device_of, namespace_of
 from .._engine.traced_loops import compiled_while, torch_compiling
 from .._validate import concrete, tolerances
 from ..errors import ConvergenceWarning
-from ..kernels import homogeneous as _kh
 from ..kernels import quaternion as _kq
 from ..kernels import se3 as _kse3
 from ..kernels import so3 as _kso3
+from ._block_tridiagonal import matvec as _matvec
+from ._block_tridiagonal import solve_block_tridiagonal
 
 __all__ = [
     "rotation_spline_coefficients",
@@ -67,42 +68,6 @@ def _const(xp, values, like):
 def _expand(h, ndim):
     """``h`` of shape (m,) reshaped to (m, 1, ..., 1) for ``ndim`` trailing axes."""
     return h.reshape((h.shape[0],) + (1,) * ndim)
-
-
-def _matvec(m, v):
-    return (m @ v[..., None])[..., 0]
-
-
-def _solve_block_tridiagonal(xp, lower, diag, upper, rhs):
-    """Block Thomas: solve ``lower[e] x[e-1] + diag[e] x[e] + upper[e] x[e+1] = rhs[e]``.
-
-    Blocks (m, ..., 3, 3), right-hand sides (m, ..., 3); ``lower[0]`` and
-    ``upper[-1]`` are ignored. The spline systems are block diagonally dominant
-    (diagonal ``4 (1/h + 1/h')``, off-diagonal norms ``<= 2/h`` and ``<= pi/h'``),
-    so no pivoting is needed. One Python step per block row.
-    """
-    m = diag.shape[0]
-    d_inv = [None] * m
-    r = [None] * m
-    d_inv[0], r[0] = _inv3(xp, diag[0]), rhs[0]
-    for e in range(1, m):
-        w = lower[e] @ d_inv[e - 1]
-        d_inv[e] = _inv3(xp, diag[e] - w @ upper[e - 1])
-        r[e] = rhs[e] - _matvec(w, r[e - 1])
-    x = [None] * m
-    x[m - 1] = _matvec(d_inv[m - 1], r[m - 1])
-    for e in range(m - 2, -1, -1):
-        x[e] = _matvec(d_inv[e], r[e] - _matvec(upper[e], x[e + 1]))
-    return xp.stack(x, axis=0)
-
-
-def _inv3(xp, a):
-    """Inverses of 3x3 blocks (..., 3, 3) by the adjugate of ``a / max|a_ij|``
-    (:func:`rigidkit.kernels.homogeneous.affine_inverse`), not ``linalg.inv``:
-    torch's checks its input for singularity as a side effect, which Inductor
-    cannot compile inside the Newton solve's while_loop (torch 2.13). The blocks
-    are diagonally dominant (above), so the adjugate loses nothing."""
-    return _kh.affine_inverse(xp.concat([a, a[..., :1] * 0.0], axis=-1))[0][..., :3]
 
 
 def _relative_rotvecs(quats):
@@ -211,7 +176,7 @@ def _newton_step(xp, params, w):
         dn = _nonlinear(theta, rdot + e) - base - _nonlinear(theta, e)
         cols.append(dn / s)
     g = xp.stack(cols, axis=-1) @ jr_inv
-    step = _solve_block_tridiagonal(xp, lower, center + g, upper, res)
+    step = solve_block_tridiagonal(xp, lower, center + g, upper, res)
     return w - step, step
 
 
