@@ -157,6 +157,14 @@ def test_interpolators_compile_with_numpy_knots(name, checks, keys, torch):
         out = compiled(*[torch.tensor(a) for a in args])
     assert isinstance(out, torch.Tensor)
     assert np.allclose(out.numpy(), fn(*args), rtol=0, atol=1e-12)
+    if name == "Slerp":  # and against scipy's Slerp, an independent reference
+        from scipy.spatial.transform import Rotation as SciRotation
+        from scipy.spatial.transform import Slerp as SciSlerp
+
+        sci_keys = SciRotation.from_quat(rotations.as_quat(), scalar_first=True)
+        want = SciSlerp(times, sci_keys)(q).as_matrix()
+        got = rk.Rotation.from_quat(out.numpy()).as_matrix()
+        assert np.allclose(got, want, rtol=0, atol=1e-14)
 
 
 def test_compiled_rotation_spline_gradient_in_the_keyframes(keys, torch):
@@ -422,6 +430,16 @@ def test_geodesic_mean_under_torch_compile(spread, torch):
         torch._dynamo.reset()
         got = torch.compile(fn, fullgraph=True, backend="eager")(torch.tensor(x))
         assert np.allclose(got.numpy(), fn(x), rtol=0, atol=1e-12)
+    # and the defining property, independent of the code: at the compiled rotation
+    # mean mu the logs log(mu^-1 R_i) sum to zero (the Karcher condition)
+    torch._dynamo.reset()
+    mu = rk.Rotation.from_rotvec(
+        torch.compile(_geodesic_mean, fullgraph=True, backend="eager")(
+            torch.tensor(spread)
+        ).numpy()
+    )
+    logs = (mu.inv() @ rk.Rotation.from_rotvec(spread)).as_rotvec()
+    assert np.abs(logs.sum(axis=0)).max() < 1e-10
 
 
 def test_reduce_of_one_rotation_compiles(torch):
