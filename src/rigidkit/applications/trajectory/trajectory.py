@@ -294,8 +294,9 @@ class Trajectory:
         q = host_stamps(check_stamps(times, n, "times"))
         if len(t) < 2:
             raise OutOfRangeError(f"interpolation needs at least 2 poses, got {len(t)}")
-        # (not while torch.compile traces: the NumPy times are graph values then)
-        if len(q) and not dynamo_traces() and (q[0] < t[0] or q[-1] > t[-1]):
+        # (checks_now: not while torch.compile traces the NumPy times, nor with
+        # rk.set_validation(False), as every check that reads values)
+        if len(q) and checks_now(q) and (q[0] < t[0] or q[-1] > t[-1]):
             bad = q[0] if q[0] < t[0] else q[-1]
             raise OutOfRangeError(
                 f"time {float(bad)!r} lies outside the trajectory's range "
